@@ -1,0 +1,50 @@
+// GRANULAR-CHARGED FMM core library (gcfmm).
+// Dual-tree traversal (target tree against the source tree shifted by each periodic image
+// shift) producing the M2L and P2P interaction lists.
+//
+// Multipole acceptance criterion (MAC) for target node A and source node B shifted by s:
+//     r_A + r_B < theta |c_A - (c_B + s)|
+// (r: radius of the node's particles about its expansion centre c). Accepted pairs become
+// M2L, unless n_A n_B <= pair_limit, where the direct sum is cheaper (then P2P). Rejected
+// pairs split the node with the larger radius (a leaf is never split); two rejected leaves
+// become P2P. Every (target particle, source particle, shift) triple is covered exactly once.
+#ifndef GCFMM_INTERACTION_LISTS_HPP
+#define GCFMM_INTERACTION_LISTS_HPP
+
+#include <cstdint>
+#include <vector>
+
+#include "gcfmm/tree.hpp"
+#include "gcfmm/types.hpp"
+
+namespace gcfmm {
+
+//! One interaction: the particles/expansion of `source` shifted by shifts[shift] act on `target`.
+struct Interaction {
+  std::int32_t target;  //!< target node
+  std::int32_t source;  //!< source node
+  std::int32_t shift;   //!< index into InteractionLists::shifts
+};
+
+//! Interaction lists sorted by target node, with CSR offsets.
+struct InteractionLists {
+  std::vector<Vec3> shifts;               //!< image shifts of the source tree
+  std::vector<Interaction> m2l;           //!< multipole-to-local interactions
+  std::vector<Interaction> p2p;           //!< direct interactions (node ranges)
+  std::vector<std::uint32_t> m2l_offset;  //!< entries of node i: m2l[m2l_offset[i] .. m2l_offset[i+1])
+  std::vector<std::uint32_t> p2p_offset;  //!< entries of node i: p2p[p2p_offset[i] .. p2p_offset[i+1])
+  std::size_t p2p_pairs = 0;              //!< number of particle pairs in the P2P list
+};
+
+/** @brief Build the lists by dual-tree traversal for every shift.
+ *  @param tree built tree (targets and sources are the same particles)
+ *  @param shifts image shifts of the sources (the free-space case is the single shift 0)
+ *  @param theta MAC opening angle, 0 < theta < 1
+ *  @param pair_limit accepted pairs with n_A n_B <= pair_limit go to P2P instead of M2L
+ *  @param lists output */
+void build_lists(const Tree &tree, const std::vector<Vec3> &shifts, double theta, double pair_limit,
+                 InteractionLists &lists);
+
+}  // namespace gcfmm
+
+#endif

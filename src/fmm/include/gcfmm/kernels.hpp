@@ -1,0 +1,33 @@
+// GRANULAR-CHARGED FMM core library (gcfmm).
+// Particle-particle (P2P) kernel of the bare 1/r interaction and O(N^2) reference sums.
+//   pot_i += sum_j q_j / |r_i - r_j - s|,   E_i += sum_j q_j (r_i - r_j - s) / |r_i - r_j - s|^3
+// (s: image shift of the sources). Pairs at zero distance contribute nothing (self term).
+#ifndef GCFMM_KERNELS_HPP
+#define GCFMM_KERNELS_HPP
+
+#include <cstddef>
+
+namespace gcfmm {
+
+/** @brief Vectorised P2P: add the potential and field of sources (xs, ys, zs, qs)[0..ns),
+ *  shifted by (sx, sy, sz), at targets (xt, yt, zt)[0..nt). Structure-of-arrays inputs.
+ *  Pairs with |r_i - r_j - s| = 0 are skipped. The result for each target depends only on
+ *  its own position and the source range (not on the other targets). */
+void p2p(std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
+         const double *xs, const double *ys, const double *zs, const double *qs, double sx, double sy,
+         double sz, double *pot, double *ex, double *ey, double *ez);
+
+/** @brief O(N^2) free-space reference: pot_i = sum_{j != i} q_j / r_ij and E_i = -grad pot_i
+ *  (outputs are overwritten). Coincident pairs are skipped. */
+void direct_free(std::size_t n, const double *x, const double *y, const double *z, const double *q,
+                 double *pot, double *ex, double *ey, double *ez);
+
+/** @brief O(N^2 (2 images + 1)^2) reference over the own cell and all image cells
+ *  (nx lx, ny ly, 0) with max(|nx|,|ny|) <= images; the self term is dropped only for the
+ *  unshifted copy (outputs are overwritten). No far field. */
+void direct_images(std::size_t n, const double *x, const double *y, const double *z, const double *q,
+                   double lx, double ly, int images, double *pot, double *ex, double *ey, double *ez);
+
+}  // namespace gcfmm
+
+#endif

@@ -1,0 +1,52 @@
+// GRANULAR-CHARGED FMM core library (gcfmm).
+// User options of the solver and the rule that turns `accuracy` into (order, theta, leaf).
+#ifndef GCFMM_OPTIONS_HPP
+#define GCFMM_OPTIONS_HPP
+
+#include <cmath>
+
+namespace gcfmm {
+
+//! Boundary conditions. Periodic2D: periodic in x and y, open in z.
+enum class Boundary { Free, Periodic2D };
+//! Treatment of the image cells beyond the `images` shells (Periodic2D only).
+enum class FarField { None, Average, Exact };
+
+//! Largest expansion order accepted by Options::validate().
+inline constexpr int kMaxOrder = 30;
+
+//! Solver options. Zero means "choose from accuracy" for order, theta and leaf.
+struct Options {
+  double accuracy = 1e-4;  //!< requested relative RMS force error
+  int order = 0;           //!< expansion order p; 0 = choose from accuracy
+  double theta = 0.0;      //!< opening angle of the MAC; 0 = choose from accuracy
+  int leaf = 0;            //!< max particles per leaf; 0 = choose
+  int images = 1;          //!< shells of periodic image cells in the near field (1 = 3x3 block)
+  Boundary boundary = Boundary::Free;  //!< boundary conditions
+  FarField farfield = FarField::Exact; //!< far field beyond the shells (Periodic2D only)
+  double bed_zlo = NAN;  //!< bed bottom for FarField::Average; NaN = min z of charged particles
+  double bed_zhi = NAN;  //!< bed top for FarField::Average; NaN = max z of charged particles
+
+  /** @brief Check every field; throws std::invalid_argument naming the bad field and value. */
+  void validate() const;
+};
+
+//! Parameters actually used, derived from Options by resolve().
+struct Resolved {
+  int order = 0;                 //!< expansion order p
+  double theta = 0.0;            //!< MAC opening angle
+  int leaf = 0;                  //!< max particles per leaf
+  double estimated_error = 0.0;  //!< predicted relative RMS force error of the near field
+};
+
+/** @brief Apply the error-control rule (see src/fmm/README.md) to the options.
+ *  @param opts validated options
+ *  @return order, theta and leaf (explicit user values are kept) and the predicted error */
+Resolved resolve(const Options &opts);
+
+/** @brief Predicted relative RMS force error of the calibrated model for (order, theta). */
+double predicted_error(int order, double theta);
+
+}  // namespace gcfmm
+
+#endif

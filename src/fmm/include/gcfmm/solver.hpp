@@ -1,0 +1,80 @@
+// GRANULAR-CHARGED FMM core library (gcfmm).
+// The driver: adaptive octree FMM for the bare 1/r kernel, free space or 2D periodic.
+#ifndef GCFMM_SOLVER_HPP
+#define GCFMM_SOLVER_HPP
+
+#include <cstddef>
+#include <memory>
+
+#include "gcfmm/kernels.hpp"
+#include "gcfmm/options.hpp"
+
+namespace gcfmm {
+
+//! Parameters used and timings of the last build()/evaluate() (seconds).
+struct Stats {
+  int order = 0;                 //!< expansion order p
+  double theta = 0.0;            //!< MAC opening angle
+  int leaf = 0;                  //!< max particles per leaf
+  int levels = 0;                //!< tree levels
+  std::size_t nodes = 0;         //!< tree nodes
+  std::size_t leaves = 0;        //!< tree leaves
+  double estimated_error = 0.0;  //!< predicted relative RMS force error (near field; plus far field)
+  std::size_t m2l_count = 0;     //!< M2L interactions (all shifts)
+  std::size_t p2p_pairs = 0;     //!< particle pairs summed directly (all shifts)
+  double t_build = 0.0;          //!< tree + lists (+ far-field set-up) in build()
+  double t_upward = 0.0;         //!< P2M + M2M
+  double t_m2l = 0.0;            //!< M2L
+  double t_p2p = 0.0;            //!< P2P
+  double t_downward = 0.0;       //!< L2L + L2P
+  double t_far = 0.0;            //!< far field beyond the image shells
+};
+
+/** Adaptive FMM solver. Usage: Solver s(opts); s.set_box(...) (periodic); s.build(n, x, y, z);
+ *  s.evaluate(q, pot, ex, ey, ez) (any number of times with new charges); s.stats(). */
+class Solver {
+ public:
+  explicit Solver(const Options &opts);
+  ~Solver();
+  Solver(const Solver &) = delete;
+  Solver &operator=(const Solver &) = delete;
+
+  /** @brief Periodic2D only: the primary cell [xlo, xlo+lx) x [ylo, ylo+ly). */
+  void set_box(double xlo, double ylo, double lx, double ly);
+
+  /** @brief Build the tree and interaction lists for n particles. Positions of a periodic
+   *  system may lie outside the primary cell: x and y are wrapped into it internally.
+   *  Charges are not needed. */
+  void build(std::size_t n, const double *x, const double *y, const double *z);
+
+  /** @brief For every particle i: pot[i] = sum_{j != i} q_j / |r_i - r_j| (plus the periodic
+   *  images for Periodic2D: `images` shells by the FMM, the far field per Options::farfield)
+   *  and E = -grad pot. Bare 1/r kernel (Gaussian units): multiply by the Coulomb constant.
+   *  The self term (j = i, unshifted) is dropped; zero-charge particles are sources of
+   *  nothing but get their field. No neutrality is assumed (net charge is allowed).
+   *  With nparts > 1 only the targets of work partition `part` (contiguous leaf ranges
+   *  balanced by estimated cost, the same on every caller) are computed and all others are
+   *  set to 0; the sum over parts is bit-identical to nparts = 1.
+   *  @throws std::runtime_error if two distinct particles share a position and either has
+   *  a nonzero charge (the field would be infinite), or if build() was not called. */
+  void evaluate(const double *q, double *pot, double *ex, double *ey, double *ez, int part = 0, int nparts = 1);
+
+  /** @brief Parameters and timings of the last build()/evaluate(). */
+  const Stats &stats() const;
+
+  /** @brief Options after validation, with order/theta/leaf as resolved. */
+  const Options &options() const;
+  /** @brief Number of particles of the last build(). */
+  std::size_t size() const;
+  /** @brief Range [first, last) of particle indices in the internal (sorted) order computed by
+   *  work partition `part` of `nparts` (for tests and diagnostics). */
+  void partition(int part, int nparts, std::size_t &first, std::size_t &last) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace gcfmm
+
+#endif

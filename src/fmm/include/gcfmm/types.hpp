@@ -1,0 +1,33 @@
+// GRANULAR-CHARGED FMM core library (gcfmm).
+// Basic types shared by all layers. No LAMMPS headers.
+#ifndef GCFMM_TYPES_HPP
+#define GCFMM_TYPES_HPP
+
+#include <cstddef>
+#include <cstdint>
+
+namespace gcfmm {
+
+//! A point or vector in 3D.
+struct Vec3 {
+  double x = 0.0;  //!< x component
+  double y = 0.0;  //!< y component
+  double z = 0.0;  //!< z component
+};
+
+inline Vec3 operator+(const Vec3 &a, const Vec3 &b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline Vec3 operator-(const Vec3 &a, const Vec3 &b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline double norm2(const Vec3 &a) { return a.x * a.x + a.y * a.y + a.z * a.z; }
+
+//! Read-only structure-of-arrays view of particle positions (and optionally charges).
+struct ParticleView {
+  std::size_t n = 0;          //!< number of particles
+  const double *x = nullptr;  //!< x coordinates
+  const double *y = nullptr;  //!< y coordinates
+  const double *z = nullptr;  //!< z coordinates
+  const double *q = nullptr;  //!< charges (may be null where not needed)
+};
+
+}  // namespace gcfmm
+
+#endif

@@ -1,0 +1,67 @@
+// GRANULAR-CHARGED FMM core library (gcfmm): dual-tree traversal.
+#include "gcfmm/interaction_lists.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace gcfmm {
+
+void build_lists(const Tree &tree, const std::vector<Vec3> &shifts, double theta, double pair_limit,
+                 InteractionLists &L) {
+  L.shifts = shifts;
+  L.m2l.clear();
+  L.p2p.clear();
+  L.p2p_pairs = 0;
+  const std::size_t nn = tree.nodes.size();
+  L.m2l_offset.assign(nn + 1, 0);
+  L.p2p_offset.assign(nn + 1, 0);
+  if (nn == 0) return;
+  const auto &nodes = tree.nodes;
+  const double th2 = theta * theta;
+  std::vector<std::pair<std::int32_t, std::int32_t>> stack;
+  stack.reserve(1024);
+  for (std::size_t s = 0; s < shifts.size(); ++s) {
+    const Vec3 sh = shifts[s];
+    const auto si = static_cast<std::int32_t>(s);
+    stack.clear();
+    stack.emplace_back(0, 0);
+    while (!stack.empty()) {
+      const auto [a, b] = stack.back();
+      stack.pop_back();
+      const Node &A = nodes[a];
+      const Node &B = nodes[b];
+      const double dx = A.center.x - B.center.x - sh.x, dy = A.center.y - B.center.y - sh.y,
+                   dz = A.center.z - B.center.z - sh.z;
+      const double d2 = dx * dx + dy * dy + dz * dz;
+      const double rs = A.radius + B.radius;
+      const double pairs = double(A.count()) * double(B.count());
+      if (rs * rs < th2 * d2) {
+        if (pairs <= pair_limit) {
+          L.p2p.push_back({a, b, si});
+          L.p2p_pairs += static_cast<std::size_t>(pairs);
+        } else {
+          L.m2l.push_back({a, b, si});
+        }
+      } else if (A.leaf() && B.leaf()) {
+        L.p2p.push_back({a, b, si});
+        L.p2p_pairs += static_cast<std::size_t>(pairs);
+      } else if (B.leaf() || (!A.leaf() && A.radius >= B.radius)) {
+        for (int c = A.nchild - 1; c >= 0; --c) stack.emplace_back(A.child + c, b);
+      } else {
+        for (int c = B.nchild - 1; c >= 0; --c) stack.emplace_back(a, B.child + c);
+      }
+    }
+  }
+  auto by_target = [](const Interaction &u, const Interaction &v) { return u.target < v.target; };
+  std::stable_sort(L.m2l.begin(), L.m2l.end(), by_target);
+  std::stable_sort(L.p2p.begin(), L.p2p.end(), by_target);
+  for (const auto &e : L.m2l) ++L.m2l_offset[e.target + 1];
+  for (const auto &e : L.p2p) ++L.p2p_offset[e.target + 1];
+  for (std::size_t i = 0; i < nn; ++i) {
+    L.m2l_offset[i + 1] += L.m2l_offset[i];
+    L.p2p_offset[i + 1] += L.p2p_offset[i];
+  }
+}
+
+}  // namespace gcfmm

@@ -1,0 +1,70 @@
+// GRANULAR-CHARGED FMM core library (gcfmm): option validation and error-control rule.
+#include "gcfmm/options.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+namespace gcfmm {
+
+namespace {
+std::string num(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+}  // namespace
+
+void Options::validate() const {
+  if (!(accuracy > 0.0 && accuracy < 1.0))
+    throw std::invalid_argument("gcfmm: accuracy must be in (0,1), got " + num(accuracy));
+  if (order < 0) throw std::invalid_argument("gcfmm: order must be >= 0 (0 = auto), got " + std::to_string(order));
+  if (order > kMaxOrder)
+    throw std::invalid_argument("gcfmm: order must be <= " + std::to_string(kMaxOrder) + ", got " +
+                                std::to_string(order));
+  if (!(theta >= 0.0 && theta < 1.0))
+    throw std::invalid_argument("gcfmm: theta must be in [0,1) (0 = auto), got " + num(theta));
+  if (leaf < 0) throw std::invalid_argument("gcfmm: leaf must be >= 0 (0 = auto), got " + std::to_string(leaf));
+  if (images < 0) throw std::invalid_argument("gcfmm: images must be >= 0, got " + std::to_string(images));
+  if (images > 20) throw std::invalid_argument("gcfmm: images must be <= 20, got " + std::to_string(images));
+  if (!std::isnan(bed_zlo) && !std::isfinite(bed_zlo))
+    throw std::invalid_argument("gcfmm: bed_zlo must be finite or NaN");
+  if (!std::isnan(bed_zhi) && !std::isfinite(bed_zhi))
+    throw std::invalid_argument("gcfmm: bed_zhi must be finite or NaN");
+  if (std::isnan(bed_zlo) != std::isnan(bed_zhi))
+    throw std::invalid_argument("gcfmm: bed_zlo and bed_zhi must be given together");
+  if (!std::isnan(bed_zlo) && !(bed_zhi > bed_zlo))
+    throw std::invalid_argument("gcfmm: bed_zhi must be > bed_zlo, got " + num(bed_zlo) + " .. " + num(bed_zhi));
+}
+
+// Calibrated model of the relative RMS force error (see doc/fmm-accuracy.md):
+//   err(p, theta) = kErrC * theta^(p+1)
+// fitted as an upper envelope of the measurements on random free-space charges and on the
+// deposition geometry (periodic near field), so the rule errs on the safe side.
+double predicted_error(int order, double theta) {
+  constexpr double kErrC = 0.5;
+  return kErrC * std::pow(theta, order + 1);
+}
+
+Resolved resolve(const Options &o) {
+  Resolved r;
+  constexpr double kDefaultTheta = 0.5;
+  r.theta = o.theta > 0.0 ? o.theta : kDefaultTheta;
+  if (o.order > 0) {
+    r.order = o.order;
+  } else {
+    r.order = 1;
+    while (r.order < kMaxOrder && predicted_error(r.order, r.theta) > o.accuracy) ++r.order;
+  }
+  if (o.leaf > 0) {
+    r.leaf = o.leaf;
+  } else {
+    // balance P2P (grows with leaf) against M2L (grows with order^4 / leaf)
+    r.leaf = r.order <= 4 ? 24 : (r.order <= 8 ? 40 : (r.order <= 12 ? 64 : 96));
+  }
+  r.estimated_error = predicted_error(r.order, r.theta);
+  return r;
+}
+
+}  // namespace gcfmm
