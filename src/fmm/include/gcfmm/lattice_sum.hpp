@@ -1,0 +1,178 @@
+// GRANULAR-CHARGED FMM core library (gcfmm).
+// 2D-periodic (x, y periodic; z open) lattice sums of the bare 1/r kernel and the exact far
+// field of all image cells beyond the near block. No LAMMPS headers; only std and Eigen.
+//
+// Notation (Gaussian units, the caller multiplies by its Coulomb constant):
+//   cell periods lx, ly; area A = lx * ly; image shift n = (nx lx, ny ly, 0);
+//   potential pot(r) = sum_j q_j K(r - r_j), field E = -grad pot.
+// See doc/fmm-far-field.md for the derivations, error control and measured costs.
+#ifndef GCFMM_LATTICE_SUM_HPP
+#define GCFMM_LATTICE_SUM_HPP
+
+#include <Eigen/Dense>
+
+#include <cstddef>
+#include <vector>
+
+namespace gcfmm {
+
+/**
+ * @brief Full 2D-periodic Green's function of the 1/r kernel and its gradient.
+ *
+ * G(d) = sum over all images n of 1/|d + n|, made convergent by dropping the divergent
+ * k = 0 Fourier term 2 pi / (A k). Equivalently (both forms are implemented and agree to
+ * round-off):
+ *
+ *   G(d) = -2 pi |dz| / A + (2 pi / A) sum_{k != 0} cos(k.rho) exp(-|k| |dz|) / |k|        (Fourier)
+ *        = sum_n erfc(alpha r_n) / r_n
+ *          + (pi / A) sum_{k != 0} cos(k.rho) / |k| [ e^{k dz} erfc(k/2alpha + alpha dz)
+ *                                                   + e^{-k dz} erfc(k/2alpha - alpha dz) ]
+ *          - (2 pi / A) [ dz erf(alpha dz) + exp(-alpha^2 dz^2) / (alpha sqrt(pi)) ]      (2D Ewald)
+ *
+ * with rho = (dx, dy), k = 2 pi (mx / lx, my / ly). The constant: G is the symmetric
+ * square-shell limit
+ *
+ *   G(d) = lim_{M -> inf} [ sum_{max(|nx|,|ny|) <= M} 1/|d + n|  -  C_M ],
+ *   C_M  = (4 / A) [ a asinh(b / a) + b asinh(a / b) ],  a = (M + 1/2) lx,  b = (M + 1/2) ly,
+ *
+ * i.e. the lattice sum minus the integral of 1/|rho| over the (2M+1) lx x (2M+1) ly rectangle
+ * of the summed cells, divided by A (checked numerically in unittest/fmm/test_lattice_sum.cpp).
+ * The gradient needs no constant: it is the square-shell limit of the field sum.
+ * Far above a unit charge grad_z G -> -2 pi sign(dz) / A (the field 2 pi / A of a sheet).
+ *
+ * @param dx,dy,dz separation (any value; reduced modulo the periods internally)
+ * @param lx,ly    periods (> 0)
+ * @param g        out: G (may be null)
+ * @param gx,gy,gz out: gradient of G (each may be null)
+ * @pre d is not on a lattice point (dz != 0 or rho not a lattice vector)
+ */
+void periodic_green(double dx, double dy, double dz, double lx, double ly, double *g, double *gx,
+                    double *gy, double *gz);
+
+/**
+ * @brief The pure Fourier form of periodic_green (see above), truncated where exp(-|k||dz|)
+ * < 1e-17. Fast for |dz| >~ min(lx, ly) / 2; cost grows like 1/dz^2. @pre dz != 0.
+ */
+void periodic_green_fourier(double dx, double dy, double dz, double lx, double ly, double *g,
+                            double *gx, double *gy, double *gz);
+
+/**
+ * @brief The 2D Ewald form of periodic_green with splitting parameter alpha * min(lx, ly)
+ * = 4, real space summed over 3 x 3 cells and reciprocal space to |k| <= 13 alpha.
+ * Accurate to round-off for |dz| <= min(lx, ly); periodic_green uses it below
+ * green_switch_height(lx, ly) and the Fourier form above.
+ */
+void periodic_green_ewald(double dx, double dy, double dz, double lx, double ly, double *g,
+                          double *gx, double *gy, double *gz);
+
+/// @brief |dz| at which periodic_green switches from the Ewald to the Fourier form.
+double green_switch_height(double lx, double ly);
+
+/**
+ * @brief Exact far-field kernel R(d) = G(d) - sum_{max(|nx|,|ny|) <= images} 1/|d + n|
+ * (and its gradient): the potential of all images beyond `images` shells, in the constant
+ * convention of periodic_green. @pre images >= 0, d not on an excluded lattice point.
+ */
+void far_kernel(double dx, double dy, double dz, double lx, double ly, int images, double *r,
+                double *rx, double *ry, double *rz);
+
+/**
+ * @brief Field of all image cells beyond `images` shells (max(|nx|,|ny|) > images), the
+ * exact lattice sum to the requested accuracy.
+ *
+ * Method (black-box FMM of Fong & Darve, J. Comput. Phys. 228 (2009) 8712, applied to the
+ * smooth far kernel R above): the column [zlo, zhi] (padded) is split into nb boxes of
+ * full cell width and height hz <= 0.75 min(lx, ly); each box carries a tensor Chebyshev
+ * grid of p x p x pz nodes; charges are anterpolated to the nodes, the node potentials are
+ * M_{t-s} W_s with the precomputed matrices M_o[a, b] = R(node_a - node_b - o hz e_z)
+ * (translation invariant, so one matrix per box offset o, and M_{-o} = M_o^T since R is
+ * even), and potential and field at the targets are the Chebyshev interpolant and its
+ * derivative. Cost: set-up evaluates R once per distinct node difference (about
+ * (p^2/2)^2 nb pz^2 values) and fills nb matrices of size (p^2 pz)^2; evaluate costs
+ * O(N p^2 pz + nb^2 (p^2 pz)^2), independent of the particle distribution.
+ *
+ * Conventions: pot_i = sum_j q_j R(r_i - r_j) (all j, including j = i: R is smooth at 0 and
+ * R(0) is the self-energy of i with its far images), E_i = -grad pot_i. The monopole (sheet
+ * field of a net-charged layer) is kept exactly, nothing is neutralised. Because R is even,
+ * the exact far field exerts zero total force on the cell: sum_i q_i E_i = 0 (the
+ * interpolated one does so to the interpolation accuracy).
+ *
+ * Requirements: images >= 1 (with images = 0 the kernel is singular inside the cell
+ * difference domain); positions inside the primary cell and the stored z range (a margin
+ * of 1% of the cell size is tolerated, beyond it evaluate throws std::invalid_argument).
+ */
+class PeriodicFarField {
+ public:
+  /**
+   * @brief Precompute the operator.
+   * @param x0,y0,lx,ly primary cell [x0,x0+lx) x [y0,y0+ly)
+   * @param zlo,zhi     z range containing all particles (stored with headroom)
+   * @param images      near-block shells handled by the caller (>= 1)
+   * @param accuracy    requested relative accuracy of the far field (1e-2 .. 1e-10)
+   * @throws std::invalid_argument on bad arguments
+   */
+  void setup(double x0, double y0, double lx, double ly, double zlo, double zhi, int images,
+             double accuracy);
+
+  /// @brief true when the stored operator does not cover this geometry (different cell, z
+  /// range outside the stored one or much smaller than it, other images or accuracy).
+  bool needs_setup(double x0, double y0, double lx, double ly, double zlo, double zhi, int images,
+                   double accuracy) const;
+
+  /**
+   * @brief ADDS far-field potential and field at targets i in [begin, end).
+   * Sources are all n particles (inside the primary cell). pot, ex, ey, ez are indexed by
+   * particle (length >= end); pot may be null.
+   * @throws std::logic_error if setup was not called; std::invalid_argument if a particle
+   *         lies outside the stored geometry.
+   */
+  void evaluate(std::size_t n, const double *x, const double *y, const double *z, const double *q,
+                std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
+                double *ez) const;
+
+  /// @brief Estimated relative error of the far field: RMS error of the interpolated kernel
+  /// gradient over random sample pairs, divided by the sheet field 2 pi / A of a unit charge.
+  double estimated_error() const { return est_error_; }
+
+  int order_xy() const { return pxy_; }           //!< Chebyshev nodes per box in x and y
+  int order_z() const { return pz_; }             //!< Chebyshev nodes per box in z
+  int boxes() const { return nb_; }               //!< number of boxes in the column
+  double box_height() const { return hz_; }       //!< height of one box
+  double stored_zlo() const { return zlo_; }      //!< lower end of the stored (padded) z range
+  double stored_zhi() const { return zhi_; }      //!< upper end of the stored (padded) z range
+  double setup_seconds() const { return setup_s_; }  //!< wall time of the last setup
+  std::size_t memory_bytes() const;               //!< bytes held by the operator
+  bool ready() const { return nb_ > 0; }          //!< setup has been called
+
+  /// @brief Choice of (p, pz, hz / min(lx, ly)) for a requested accuracy (used by setup).
+  static void parameters_for(double accuracy, int *pxy, int *pz, double *hz_over_l);
+
+  /// @brief Setup with explicit interpolation parameters (tests and tuning).
+  void setup_explicit(double x0, double y0, double lx, double ly, double zlo, double zhi,
+                      int images, int pxy, int pz, double hz_max);
+
+ private:
+  static void interp_weights(double t, int p, const double *tab, double *s, double *ds);
+  void apply(const Eigen::MatrixXd &w, Eigen::MatrixXd &phi) const;
+  int locate(std::size_t i, double x, double y, double z, double *tx, double *ty, double *tz) const;
+  void interpolate(const Eigen::MatrixXd &phi, const double *x, const double *y, const double *z,
+                   std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
+                   double *ez) const;
+  double sample_error() const;
+
+  double x0_ = 0, y0_ = 0, lx_ = 0, ly_ = 0;  //!< primary cell
+  double zlo_ = 0, zhi_ = 0;                  //!< stored (padded) z range
+  double req_zlo_ = 0, req_zhi_ = 0;          //!< z range asked for at setup
+  int images_ = -1;                           //!< near-block shells excluded
+  double accuracy_ = 0;                       //!< requested accuracy
+  int pxy_ = 0, pz_ = 0, nb_ = 0;             //!< nodes per box, boxes
+  double hz_ = 0;                             //!< box height
+  double est_error_ = 0;                      //!< sampled relative kernel error
+  double setup_s_ = 0;                        //!< set-up wall time
+  std::vector<Eigen::MatrixXd> ops_;          //!< M_o for offsets o = 0 .. nb-1 (target - source)
+  std::vector<double> tab_xy_, tab_z_;        //!< T_k(t_i) at the Chebyshev nodes
+};
+
+}  // namespace gcfmm
+
+#endif

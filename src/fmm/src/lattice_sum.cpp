@@ -1,0 +1,570 @@
+// GRANULAR-CHARGED FMM core library (gcfmm).
+// 2D-periodic Green's function (2D Ewald / Fourier forms) and the exact far field of the
+// image cells beyond the near block (Chebyshev interpolation of the smooth far kernel).
+// Notation and conventions: include/gcfmm/lattice_sum.hpp and doc/fmm-far-field.md.
+#include "gcfmm/lattice_sum.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+namespace gcfmm {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kTwoOverSqrtPi = 1.12837916709551257390;  // 2 / sqrt(pi)
+constexpr double kEwaldAlphaL = 4.0;   // alpha * min(lx, ly): erfc(1.5 * 4) = 2e-17 beyond 3x3 cells
+constexpr double kEwaldKmax = 13.0;    // |k| <= 13 alpha: erfc(6.5) = 4e-20
+constexpr double kFourierDecay = 40.0; // keep terms with |k||dz| <= 40: e^-40 = 4e-18
+constexpr double kSwitch = 0.75;       // Fourier form for |dz| >= 0.75 min(lx, ly)
+
+// cos(m theta), sin(m theta) for m = 0 .. mmax by complex multiplication
+void trig_table(double theta, int mmax, std::vector<double> &c, std::vector<double> &s) {
+  c.resize(mmax + 1);
+  s.resize(mmax + 1);
+  const double c1 = std::cos(theta), s1 = std::sin(theta);
+  c[0] = 1.0;
+  s[0] = 0.0;
+  for (int m = 1; m <= mmax; ++m) {
+    // re-seed every 16 steps to keep the recurrence error at a few ulp
+    if (m % 16 == 0) {
+      c[m] = std::cos(m * theta);
+      s[m] = std::sin(m * theta);
+    } else {
+      c[m] = c[m - 1] * c1 - s[m - 1] * s1;
+      s[m] = s[m - 1] * c1 + c[m - 1] * s1;
+    }
+  }
+}
+
+inline double reduce(double d, double l) { return d - l * std::nearbyint(d / l); }
+
+void set_out(double *p, double v) {
+  if (p) *p = v;
+}
+
+void check_periods(double lx, double ly) {
+  if (!(lx > 0.0) || !(ly > 0.0) || !std::isfinite(lx) || !std::isfinite(ly))
+    throw std::invalid_argument("gcfmm::periodic_green: periods must be positive and finite");
+}
+
+}  // namespace
+
+double green_switch_height(double lx, double ly) { return kSwitch * std::min(lx, ly); }
+
+void periodic_green_fourier(double dx, double dy, double dz, double lx, double ly, double *g,
+                            double *gx, double *gy, double *gz) {
+  check_periods(lx, ly);
+  if (dz == 0.0) throw std::invalid_argument("gcfmm::periodic_green_fourier: needs dz != 0");
+  dx = reduce(dx, lx);
+  dy = reduce(dy, ly);
+  const double az = std::fabs(dz), sg = dz > 0 ? 1.0 : -1.0;
+  const double area = lx * ly;
+  const double kmax = kFourierDecay / az;
+  const double bx = 2.0 * kPi / lx, by = 2.0 * kPi / ly;
+  const int mx = static_cast<int>(kmax / bx), my = static_cast<int>(kmax / by);
+  thread_local std::vector<double> cx, sx, cy, sy;
+  trig_table(bx * dx, mx, cx, sx);
+  trig_table(by * dy, my, cy, sy);
+  // Sum over the quadrant mx, my >= 0: cos(kx x + ky y) summed over the sign choices of
+  // (kx, ky) is 4 cos(kx x) cos(ky y) (2 if one component is zero).
+  double sg0 = 0, sgx = 0, sgy = 0, sgz = 0;
+  const double kmax2 = kmax * kmax;
+  for (int ix = 0; ix <= mx; ++ix) {
+    const double kx = bx * ix;
+    const double wx = ix ? 2.0 : 1.0;
+    for (int iy = 0; iy <= my; ++iy) {
+      if (ix == 0 && iy == 0) continue;
+      const double ky = by * iy;
+      const double k2 = kx * kx + ky * ky;
+      if (k2 > kmax2) break;
+      const double k = std::sqrt(k2);
+      const double w = wx * (iy ? 2.0 : 1.0) * std::exp(-k * az);
+      const double cc = cx[ix] * cy[iy];
+      sg0 += w * cc / k;
+      sgx -= w * kx * sx[ix] * cy[iy] / k;
+      sgy -= w * ky * cx[ix] * sy[iy] / k;
+      sgz += w * cc;
+    }
+  }
+  const double f = 2.0 * kPi / area;
+  set_out(g, f * (sg0 - az));
+  set_out(gx, f * sgx);
+  set_out(gy, f * sgy);
+  set_out(gz, -f * sg * (1.0 + sgz));
+}
+
+namespace {
+
+// 2D Ewald sum. Real space over the images n in the rectangle [nx0, nx1] x [ny0, ny1]
+// (relative to the unreduced d); images with max(|nx|,|ny|) <= excl carry
+// erfc(alpha r)/r - 1/r = -erf(alpha r)/r instead (excl < 0: none), which removes the
+// near block analytically (finite at r = 0). The rectangle must contain every image with
+// r < 1.5 min(lx, ly).
+void ewald_sum(double dx, double dy, double dz, double lx, double ly, int nx0, int nx1, int ny0,
+               int ny1, int excl, double *g, double *gx, double *gy, double *gz) {
+  const double area = lx * ly;
+  const double alpha = kEwaldAlphaL / std::min(lx, ly);
+  const double a2 = alpha * alpha;
+  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  for (int nx = nx0; nx <= nx1; ++nx)
+    for (int ny = ny0; ny <= ny1; ++ny) {
+      const double ux = dx + nx * lx, uy = dy + ny * ly;
+      const double r2 = ux * ux + uy * uy + dz * dz;
+      const double r = std::sqrt(r2);
+      const bool near = std::max(std::abs(nx), std::abs(ny)) <= excl;
+      double e, dr;  // value and (1/r) d/dr
+      if (!near) {
+        e = std::erfc(alpha * r) / r;
+        // d/dr [erfc(a r)/r] = -erfc(a r)/r^2 - (2a/sqrt(pi)) exp(-a^2 r^2)/r
+        dr = -(e + kTwoOverSqrtPi * alpha * std::exp(-a2 * r2)) / r2;
+      } else if (alpha * r > 1e-2) {
+        e = -std::erf(alpha * r) / r;
+        dr = -(e + kTwoOverSqrtPi * alpha * std::exp(-a2 * r2)) / r2;
+      } else {
+        // series of -erf(x)/x = -(2/sqrt(pi)) (1 - x^2/3 + x^4/10 - x^6/42), x = alpha r
+        const double x2 = a2 * r2;
+        e = -kTwoOverSqrtPi * alpha * (1.0 - x2 / 3.0 + x2 * x2 / 10.0 - x2 * x2 * x2 / 42.0);
+        dr = -kTwoOverSqrtPi * alpha * a2 * (-2.0 / 3.0 + 0.4 * x2 - x2 * x2 / 7.0);
+      }
+      s0 += e;
+      s1 += dr * ux;
+      s2 += dr * uy;
+      s3 += dr * dz;
+    }
+  dx = reduce(dx, lx);
+  dy = reduce(dy, ly);
+  // reciprocal space, k != 0
+  const double az = std::fabs(dz), sg = dz >= 0 ? 1.0 : -1.0;
+  const double kmax = kEwaldKmax * alpha;
+  const double bx = 2.0 * kPi / lx, by = 2.0 * kPi / ly;
+  const int mx = static_cast<int>(kmax / bx), my = static_cast<int>(kmax / by);
+  thread_local std::vector<double> cx, sx, cy, sy;
+  trig_table(bx * dx, mx, cx, sx);
+  trig_table(by * dy, my, cy, sy);
+  double r0 = 0, rx = 0, ry = 0, rz = 0;
+  const double kmax2 = kmax * kmax;
+  for (int ix = 0; ix <= mx; ++ix) {
+    const double kx = bx * ix;
+    const double wx = ix ? 2.0 : 1.0;
+    for (int iy = 0; iy <= my; ++iy) {
+      if (ix == 0 && iy == 0) continue;
+      const double ky = by * iy;
+      const double k2 = kx * kx + ky * ky;
+      if (k2 > kmax2) break;
+      const double k = std::sqrt(k2);
+      const double up = k / (2.0 * alpha) + alpha * az, um = k / (2.0 * alpha) - alpha * az;
+      const double ep = std::exp(k * az) * std::erfc(up);
+      const double em = std::exp(-k * az) * std::erfc(um);
+      const double w = wx * (iy ? 2.0 : 1.0) / k;
+      const double cc = cx[ix] * cy[iy];
+      const double f = ep + em;
+      r0 += w * cc * f;
+      rx -= w * kx * sx[ix] * cy[iy] * f;
+      ry -= w * ky * cx[ix] * sy[iy] * f;
+      // d/dz of F: the Gaussian terms of the two erfc derivatives cancel
+      rz += w * cc * sg * k * (ep - em);
+    }
+  }
+  const double pa = kPi / area;
+  const double ez = std::erf(alpha * az);
+  set_out(g, s0 + pa * r0 - 2.0 * pa * (az * ez + std::exp(-a2 * dz * dz) / (alpha * std::sqrt(kPi))));
+  set_out(gx, s1 + pa * rx);
+  set_out(gy, s2 + pa * ry);
+  set_out(gz, s3 + pa * rz - 2.0 * pa * sg * ez);
+}
+
+}  // namespace
+
+void periodic_green_ewald(double dx, double dy, double dz, double lx, double ly, double *g,
+                          double *gx, double *gy, double *gz) {
+  check_periods(lx, ly);
+  ewald_sum(reduce(dx, lx), reduce(dy, ly), dz, lx, ly, -1, 1, -1, 1, -1, g, gx, gy, gz);
+}
+
+void periodic_green(double dx, double dy, double dz, double lx, double ly, double *g, double *gx,
+                    double *gy, double *gz) {
+  if (std::fabs(dz) >= green_switch_height(lx, ly))
+    periodic_green_fourier(dx, dy, dz, lx, ly, g, gx, gy, gz);
+  else
+    periodic_green_ewald(dx, dy, dz, lx, ly, g, gx, gy, gz);
+}
+
+void far_kernel(double dx, double dy, double dz, double lx, double ly, int images, double *r,
+                double *rx, double *ry, double *rz) {
+  if (images < 0) throw std::invalid_argument("gcfmm::far_kernel: images must be >= 0");
+  check_periods(lx, ly);
+  if (std::fabs(dz) < green_switch_height(lx, ly)) {
+    // Ewald with the near block removed inside the real-space sum (smooth at d = 0)
+    const int cx = -static_cast<int>(std::nearbyint(dx / lx));
+    const int cy = -static_cast<int>(std::nearbyint(dy / ly));
+    ewald_sum(dx, dy, dz, lx, ly, std::min(-images, cx - 1), std::max(images, cx + 1),
+              std::min(-images, cy - 1), std::max(images, cy + 1), images, r, rx, ry, rz);
+    return;
+  }
+  double g = 0, gx = 0, gy = 0, gz = 0;
+  periodic_green_fourier(dx, dy, dz, lx, ly, &g, &gx, &gy, &gz);
+  for (int nx = -images; nx <= images; ++nx)
+    for (int ny = -images; ny <= images; ++ny) {
+      const double ux = dx + nx * lx, uy = dy + ny * ly;
+      const double r2 = ux * ux + uy * uy + dz * dz;
+      const double ir = 1.0 / std::sqrt(r2);
+      const double ir3 = ir * ir * ir;
+      g -= ir;
+      gx += ux * ir3;  // grad(1/r) = -u / r^3, subtracted
+      gy += uy * ir3;
+      gz += dz * ir3;
+    }
+  set_out(r, g);
+  set_out(rx, gx);
+  set_out(ry, gy);
+  set_out(rz, gz);
+}
+
+// --------------------------------------------------------------------------------------
+// PeriodicFarField
+
+void PeriodicFarField::parameters_for(double accuracy, int *pxy, int *pz, double *hz_over_l) {
+  if (!(accuracy > 0.0) || !(accuracy < 1.0))
+    throw std::invalid_argument("gcfmm::PeriodicFarField: accuracy must be in (0, 1), got " +
+                                std::to_string(accuracy));
+  // Calibrated in unittest/fmm/test_lattice_sum.cpp and doc/fmm-far-field.md: the kernel
+  // error falls like rho^-p with rho ~ 5.8 (x, y: nearest excluded image one cell away) and
+  // rho ~ 5.8 in z for boxes of height 0.7 L.
+  const double digits = -std::log10(accuracy);
+  int p = static_cast<int>(std::ceil(1.3 * digits)) + 1;
+  p = std::max(4, std::min(p, 16));
+  *pxy = p;
+  *pz = p;
+  *hz_over_l = 0.7;
+}
+
+void PeriodicFarField::setup(double x0, double y0, double lx, double ly, double zlo, double zhi,
+                             int images, double accuracy) {
+  int pxy = 0, pz = 0;
+  double hzl = 0;
+  parameters_for(accuracy, &pxy, &pz, &hzl);
+  setup_explicit(x0, y0, lx, ly, zlo, zhi, images, pxy, pz, hzl * std::min(lx, ly));
+  accuracy_ = accuracy;
+}
+
+bool PeriodicFarField::needs_setup(double x0, double y0, double lx, double ly, double zlo,
+                                   double zhi, int images, double accuracy) const {
+  if (!ready()) return true;
+  const double tol = 1e-12 * std::max(lx_, ly_);
+  if (std::fabs(x0 - x0_) > tol || std::fabs(y0 - y0_) > tol || std::fabs(lx - lx_) > tol ||
+      std::fabs(ly - ly_) > tol)
+    return true;
+  if (images != images_ || accuracy != accuracy_) return true;
+  if (zlo < zlo_ || zhi > zhi_) return true;
+  // much smaller than the stored range: re-setup to save boxes
+  if ((zhi - zlo) + std::min(lx_, ly_) < 0.5 * (zhi_ - zlo_)) return true;
+  return false;
+}
+
+std::size_t PeriodicFarField::memory_bytes() const {
+  std::size_t b = 0;
+  for (const auto &m : ops_) b += sizeof(double) * static_cast<std::size_t>(m.size());
+  return b;
+}
+
+void PeriodicFarField::interp_weights(double t, int p, const double *tab, double *s, double *ds) {
+  // Lagrange basis of the first-kind Chebyshev nodes t_i = cos(pi (2i+1) / 2p), written with
+  // the discrete orthogonality of T_k: S_i(t) = 1/p + (2/p) sum_{k=1}^{p-1} T_k(t_i) T_k(t),
+  // S_i'(t) = (2/p) sum_k T_k(t_i) k U_{k-1}(t). Stable everywhere on [-1, 1] and slightly beyond.
+  double tk[32], dtk[32];
+  tk[0] = 1.0;
+  dtk[0] = 0.0;
+  if (p > 1) {
+    tk[1] = t;
+    dtk[1] = 1.0;
+  }
+  double um1 = 1.0, u = 2.0 * t;  // U_0, U_1
+  for (int k = 2; k < p; ++k) {
+    tk[k] = 2.0 * t * tk[k - 1] - tk[k - 2];
+    dtk[k] = k * u;  // T_k' = k U_{k-1}
+    const double un = 2.0 * t * u - um1;
+    um1 = u;
+    u = un;
+  }
+  for (int i = 0; i < p; ++i) {
+    const double *ti = tab + static_cast<std::size_t>(i) * p;
+    double a = 0.5, b = 0.0;
+    for (int k = 1; k < p; ++k) {
+      a += ti[k] * tk[k];
+      b += ti[k] * dtk[k];
+    }
+    s[i] = 2.0 * a / p;
+    if (ds) ds[i] = 2.0 * b / p;
+  }
+}
+
+namespace {
+
+std::vector<double> cheb_nodes(int p) {
+  std::vector<double> t(p);
+  for (int i = 0; i < p; ++i) t[i] = std::cos(kPi * (2 * i + 1) / (2.0 * p));
+  return t;
+}
+
+std::vector<double> cheb_table(int p) {
+  std::vector<double> tab(static_cast<std::size_t>(p) * p);
+  const auto t = cheb_nodes(p);
+  for (int i = 0; i < p; ++i)
+    for (int k = 0; k < p; ++k) tab[static_cast<std::size_t>(i) * p + k] = std::cos(k * std::acos(t[i]));
+  return tab;
+}
+
+// distinct values (to a relative tolerance) of a list and the index of each entry
+void uniq(const std::vector<double> &v, double tol, std::vector<double> &vals, std::vector<int> &idx) {
+  std::vector<int> order(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) order[i] = static_cast<int>(i);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return v[a] < v[b]; });
+  vals.clear();
+  idx.assign(v.size(), -1);
+  for (int i : order) {
+    if (vals.empty() || v[i] - vals.back() > tol) vals.push_back(v[i]);
+    idx[i] = static_cast<int>(vals.size()) - 1;
+  }
+}
+
+}  // namespace
+
+void PeriodicFarField::setup_explicit(double x0, double y0, double lx, double ly, double zlo,
+                                      double zhi, int images, int pxy, int pz, double hz_max) {
+  const auto t_start = std::chrono::steady_clock::now();
+  if (!(lx > 0) || !(ly > 0) || !std::isfinite(x0) || !std::isfinite(y0) || !std::isfinite(lx) ||
+      !std::isfinite(ly))
+    throw std::invalid_argument("gcfmm::PeriodicFarField: bad cell");
+  if (!(zhi >= zlo) || !std::isfinite(zlo) || !std::isfinite(zhi))
+    throw std::invalid_argument("gcfmm::PeriodicFarField: need finite zlo <= zhi");
+  if (images < 1)
+    throw std::invalid_argument(
+        "gcfmm::PeriodicFarField: images must be >= 1 (the far kernel is singular inside the "
+        "cell for images = 0)");
+  if (pxy < 2 || pxy > 30 || pz < 2 || pz > 30 || !(hz_max > 0))
+    throw std::invalid_argument("gcfmm::PeriodicFarField: bad interpolation parameters");
+  x0_ = x0;
+  y0_ = y0;
+  lx_ = lx;
+  ly_ = ly;
+  images_ = images;
+  pxy_ = pxy;
+  pz_ = pz;
+  req_zlo_ = zlo;
+  req_zhi_ = zhi;
+  const double lmin = std::min(lx, ly);
+  const double pad = 0.1 * (zhi - zlo) + 0.1 * lmin;  // headroom for a growing column
+  zlo_ = zlo - pad;
+  zhi_ = zhi + pad;
+  nb_ = std::max(1, static_cast<int>(std::ceil((zhi_ - zlo_) / hz_max - 1e-9)));
+  hz_ = (zhi_ - zlo_) / nb_;
+  tab_xy_ = cheb_table(pxy);
+  tab_z_ = cheb_table(pz);
+  const auto tn = cheb_nodes(pxy), tz = cheb_nodes(pz);
+
+  // distinct |dx|, |dy| between nodes (R is even in each component)
+  std::vector<double> dxv(pxy * pxy), dyv(pxy * pxy);
+  for (int a = 0; a < pxy; ++a)
+    for (int b = 0; b < pxy; ++b) {
+      dxv[a * pxy + b] = std::fabs(0.5 * lx * (tn[a] - tn[b]));
+      dyv[a * pxy + b] = std::fabs(0.5 * ly * (tn[a] - tn[b]));
+    }
+  std::vector<double> ux, uy, uz;
+  std::vector<int> ix, iy, iz;
+  uniq(dxv, 1e-13 * lx, ux, ix);
+  uniq(dyv, 1e-13 * ly, uy, iy);
+  std::vector<double> dzv(static_cast<std::size_t>(nb_) * pz * pz);
+  for (int o = 0; o < nb_; ++o)
+    for (int c = 0; c < pz; ++c)
+      for (int d = 0; d < pz; ++d)
+        dzv[(static_cast<std::size_t>(o) * pz + c) * pz + d] = std::fabs(o * hz_ + 0.5 * hz_ * (tz[c] - tz[d]));
+  uniq(dzv, 1e-13 * hz_, uz, iz);
+
+  // table of R on the distinct differences
+  const std::size_t nx = ux.size(), ny = uy.size(), nz = uz.size();
+  std::vector<double> tab(nx * ny * nz);
+  const bool square = (lx == ly);
+  for (std::size_t a = 0; a < nx; ++a)
+    for (std::size_t b = 0; b < ny; ++b) {
+      if (square && b < a) {
+        for (std::size_t c = 0; c < nz; ++c) tab[(a * ny + b) * nz + c] = tab[(b * ny + a) * nz + c];
+        continue;
+      }
+      for (std::size_t c = 0; c < nz; ++c)
+        far_kernel(ux[a], uy[b], uz[c], lx, ly, images, &tab[(a * ny + b) * nz + c], nullptr, nullptr,
+                   nullptr);
+    }
+
+  // operators M_o, o = target box - source box >= 0; row/column index (a p + b) pz + c
+  const int nn = pxy * pxy * pz;
+  ops_.assign(nb_, Eigen::MatrixXd(nn, nn));
+  for (int o = 0; o < nb_; ++o) {
+    Eigen::MatrixXd &m = ops_[o];
+    for (int a2 = 0; a2 < pxy; ++a2)
+      for (int b2 = 0; b2 < pxy; ++b2)
+        for (int c2 = 0; c2 < pz; ++c2) {
+          const int col = (a2 * pxy + b2) * pz + c2;
+          double *mc = m.col(col).data();
+          for (int a = 0; a < pxy; ++a) {
+            const std::size_t ka = ix[a * pxy + a2] * ny;
+            for (int b = 0; b < pxy; ++b) {
+              const std::size_t kab = (ka + iy[b * pxy + b2]) * nz;
+              double *dst = mc + (a * pxy + b) * pz;
+              const int *izp = &iz[(static_cast<std::size_t>(o) * pz) * pz + c2];
+              for (int c = 0; c < pz; ++c) dst[c] = tab[kab + izp[static_cast<std::size_t>(c) * pz]];
+            }
+          }
+        }
+  }
+
+  est_error_ = sample_error();
+  accuracy_ = 0.0;
+  setup_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+}
+
+void PeriodicFarField::apply(const Eigen::MatrixXd &w, Eigen::MatrixXd &phi) const {
+  phi.noalias() = ops_[0] * w;
+  for (int o = 1; o < nb_; ++o) {
+    // target t = s + o (offset +o): M_o; target t = s - o: M_{-o} = M_o^T
+    phi.rightCols(nb_ - o).noalias() += ops_[o] * w.leftCols(nb_ - o);
+    phi.leftCols(nb_ - o).noalias() += ops_[o].transpose() * w.rightCols(nb_ - o);
+  }
+}
+
+int PeriodicFarField::locate(std::size_t i, double x, double y, double z, double *tx, double *ty,
+                             double *tz) const {
+  const double mx = 0.01 * lx_, my = 0.01 * ly_, mz = 0.01 * std::min(lx_, ly_);
+  if (!(x >= x0_ - mx && x <= x0_ + lx_ + mx && y >= y0_ - my && y <= y0_ + ly_ + my &&
+        z >= zlo_ - mz && z <= zhi_ + mz))
+    throw std::invalid_argument("gcfmm::PeriodicFarField::evaluate: particle " + std::to_string(i) +
+                                " outside the primary cell or the stored z range (call setup again)");
+  *tx = 2.0 * (x - x0_) / lx_ - 1.0;
+  *ty = 2.0 * (y - y0_) / ly_ - 1.0;
+  int b = static_cast<int>(std::floor((z - zlo_) / hz_));
+  b = std::max(0, std::min(b, nb_ - 1));
+  *tz = 2.0 * (z - zlo_ - b * hz_) / hz_ - 1.0;
+  return b;
+}
+
+void PeriodicFarField::interpolate(const Eigen::MatrixXd &phi, const double *x, const double *y,
+                                   const double *z, std::size_t begin, std::size_t end, double *pot,
+                                   double *ex, double *ey, double *ez) const {
+  const int p = pxy_, pz = pz_;
+  double sx[32], sy[32], sz[32], dsx[32], dsy[32], dsz[32];
+  const double fx = 2.0 / lx_, fy = 2.0 / ly_, fz = 2.0 / hz_;
+  for (std::size_t i = begin; i < end; ++i) {
+    double tx, ty, tz;
+    const int b = locate(i, x[i], y[i], z[i], &tx, &ty, &tz);
+    interp_weights(tx, p, tab_xy_.data(), sx, dsx);
+    interp_weights(ty, p, tab_xy_.data(), sy, dsy);
+    interp_weights(tz, pz, tab_z_.data(), sz, dsz);
+    const double *col = phi.col(b).data();
+    double f = 0, gx = 0, gy = 0, gz = 0;
+    for (int a = 0; a < p; ++a) {
+      double fa = 0, fya = 0, fza = 0;
+      for (int bb = 0; bb < p; ++bb) {
+        const double *src = col + (a * p + bb) * pz;
+        double v = 0, vz = 0;
+        for (int c = 0; c < pz; ++c) {
+          v += sz[c] * src[c];
+          vz += dsz[c] * src[c];
+        }
+        fa += sy[bb] * v;
+        fya += dsy[bb] * v;
+        fza += sy[bb] * vz;
+      }
+      f += sx[a] * fa;
+      gx += dsx[a] * fa;
+      gy += sx[a] * fya;
+      gz += sx[a] * fza;
+    }
+    if (pot) pot[i] += f;
+    ex[i] -= fx * gx;
+    ey[i] -= fy * gy;
+    ez[i] -= fz * gz;
+  }
+}
+
+double PeriodicFarField::sample_error() const {
+  // interpolated vs exact kernel gradient for unit sources at random points, each seen from
+  // random targets (one matrix-vector product per source and target box)
+  std::mt19937_64 rng(12345);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const int ns = 12, nt = 48, p = pxy_, pz = pz_, nn = p * p * pz;
+  std::vector<double> xt(nt), yt(nt), zt(nt), ex(nt), ey(nt), ez(nt);
+  double sx[32], sy[32], sz[32];
+  double sum2 = 0;
+  for (int s = 0; s < ns; ++s) {
+    const double xs = x0_ + lx_ * u01(rng), ys = y0_ + ly_ * u01(rng);
+    const double zs = zlo_ + (zhi_ - zlo_) * u01(rng);
+    double tx, ty, tz;
+    const int bs = locate(0, xs, ys, zs, &tx, &ty, &tz);
+    interp_weights(tx, p, tab_xy_.data(), sx, nullptr);
+    interp_weights(ty, p, tab_xy_.data(), sy, nullptr);
+    interp_weights(tz, pz, tab_z_.data(), sz, nullptr);
+    Eigen::VectorXd v(nn);
+    for (int a = 0; a < p; ++a)
+      for (int b = 0; b < p; ++b)
+        for (int c = 0; c < pz; ++c) v[(a * p + b) * pz + c] = sx[a] * sy[b] * sz[c];
+    Eigen::MatrixXd phi(nn, nb_);
+    for (int t = 0; t < nb_; ++t) {
+      const int o = t - bs;
+      if (o >= 0)
+        phi.col(t).noalias() = ops_[o] * v;
+      else
+        phi.col(t).noalias() = ops_[-o].transpose() * v;
+    }
+    for (int t = 0; t < nt; ++t) {
+      xt[t] = x0_ + lx_ * u01(rng);
+      yt[t] = y0_ + ly_ * u01(rng);
+      zt[t] = zlo_ + (zhi_ - zlo_) * u01(rng);
+      ex[t] = ey[t] = ez[t] = 0.0;
+    }
+    interpolate(phi, xt.data(), yt.data(), zt.data(), 0, nt, nullptr, ex.data(), ey.data(), ez.data());
+    for (int t = 0; t < nt; ++t) {
+      double gx, gy, gz;
+      far_kernel(xt[t] - xs, yt[t] - ys, zt[t] - zs, lx_, ly_, images_, nullptr, &gx, &gy, &gz);
+      sum2 += (ex[t] + gx) * (ex[t] + gx) + (ey[t] + gy) * (ey[t] + gy) + (ez[t] + gz) * (ez[t] + gz);
+    }
+  }
+  return std::sqrt(sum2 / (ns * nt)) / (2.0 * kPi / (lx_ * ly_));
+}
+
+void PeriodicFarField::evaluate(std::size_t n, const double *x, const double *y, const double *z,
+                                const double *q, std::size_t begin, std::size_t end, double *pot,
+                                double *ex, double *ey, double *ez) const {
+  if (!ready()) throw std::logic_error("gcfmm::PeriodicFarField::evaluate: setup() not called");
+  if (end > n || begin > end)
+    throw std::invalid_argument("gcfmm::PeriodicFarField::evaluate: bad target range");
+  const int p = pxy_, pz = pz_, nn = p * p * pz;
+  double sx[32], sy[32], sz[32];
+  // anterpolation: node charges W_b = sum_j q_j S(r_j) (exact total charge per box)
+  Eigen::MatrixXd w = Eigen::MatrixXd::Zero(nn, nb_);
+  for (std::size_t j = 0; j < n; ++j) {
+    double tx, ty, tz;
+    const int b = locate(j, x[j], y[j], z[j], &tx, &ty, &tz);
+    if (q[j] == 0.0) continue;
+    interp_weights(tx, p, tab_xy_.data(), sx, nullptr);
+    interp_weights(ty, p, tab_xy_.data(), sy, nullptr);
+    interp_weights(tz, pz, tab_z_.data(), sz, nullptr);
+    double *col = w.col(b).data();
+    for (int a = 0; a < p; ++a) {
+      const double qa = q[j] * sx[a];
+      for (int bb = 0; bb < p; ++bb) {
+        const double qab = qa * sy[bb];
+        double *dst = col + (a * p + bb) * pz;
+        for (int c = 0; c < pz; ++c) dst[c] += qab * sz[c];
+      }
+    }
+  }
+  Eigen::MatrixXd phi(nn, nb_);
+  apply(w, phi);
+  interpolate(phi, x, y, z, begin, end, pot, ex, ey, ez);
+}
+
+}  // namespace gcfmm
