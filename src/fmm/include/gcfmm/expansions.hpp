@@ -57,6 +57,14 @@ class Operators {
    *  L_n^m = (-1)^n sum_{k<=p-n,l} M_k^l T_{n+k}^{m+l}(R); m >= 0 only.
    *  @pre |R| > r_s + r_t (MAC); M_s full layout. */
   void m2l(const double *Ms, const Vec3 &R, double *Lt) const;
+  /** Batched M2L: L_t += sum_{e < count} T(R[e]) M[e] (all entries act on one target).
+   *  The entries are processed kBatch at a time, one per SIMD lane, so the arithmetic runs in
+   *  lock-step over independent interactions (vectorises without reductions). The result
+   *  depends only on the entry list, not on anything else. m >= 0 only. */
+  void m2l_batch(std::size_t count, const double *const *M, const Vec3 *R, double *Lt) const;
+  //! lanes of m2l_batch
+  static constexpr int kBatch = 8;
+
   /** L2L: L_child += shift of the (full) parent local expansion; b = z_child - z_parent.
    *  L'_n^m = sum_{k<=p-n,l} L_{n+k}^{m+l} conj(Y_k^l(b)); m >= 0 only. Exact for degree p. */
   void l2l(const double *Lparent, const Vec3 &b, double *Lchild) const;
@@ -71,6 +79,7 @@ class Operators {
   std::vector<double> inv_nm_;  // 1/((n+m)(n-m)) at [n*(p+1)+m]
   std::vector<double> nm1_;     // (n-1+m)(n-1-m)
   mutable std::vector<double> wr_, wi_, xr_, xi_;  // scratch harmonics
+  mutable std::vector<double> bt_, bm_, ba_;         // m2l_batch scratch: T, M, accumulators
 };
 
 }  // namespace gcfmm
