@@ -82,7 +82,7 @@ void far_kernel(double dx, double dy, double dz, double lx, double ly, int image
  *
  * Method (black-box FMM of Fong & Darve, J. Comput. Phys. 228 (2009) 8712, applied to the
  * smooth far kernel R above): the column [zlo, zhi] (padded) is split into nb boxes of
- * full cell width and height hz <= 0.75 min(lx, ly); each box carries a tensor Chebyshev
+ * full cell width and height hz <= min(lx, ly) (0.7 min(lx, ly) at 1e-8); each box carries a tensor Chebyshev
  * grid of p x p x pz nodes; charges are anterpolated to the nodes, the node potentials are
  * M_{t-s} W_s with the precomputed matrices M_o[a, b] = R(node_a - node_b - o hz e_z)
  * (translation invariant, so one matrix per box offset o, and M_{-o} = M_o^T since R is
@@ -108,7 +108,7 @@ class PeriodicFarField {
    * @param x0,y0,lx,ly primary cell [x0,x0+lx) x [y0,y0+ly)
    * @param zlo,zhi     z range containing all particles (stored with headroom)
    * @param images      near-block shells handled by the caller (>= 1)
-   * @param accuracy    requested relative accuracy of the far field (1e-2 .. 1e-10)
+   * @param accuracy    requested relative RMS accuracy of the far field, in [1e-8, 1)
    * @throws std::invalid_argument on bad arguments
    */
   void setup(double x0, double y0, double lx, double ly, double zlo, double zhi, int images,
@@ -130,8 +130,10 @@ class PeriodicFarField {
                 std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
                 double *ez) const;
 
-  /// @brief Estimated relative error of the far field: RMS error of the interpolated kernel
-  /// gradient over random sample pairs, divided by the sheet field 2 pi / A of a unit charge.
+  /// @brief Estimated relative RMS error of the far field: the larger of the error measured
+  /// for these parameters in the calibration (setup only) and 20 x the RMS error of the
+  /// interpolated kernel gradient over random sample pairs divided by the sheet field
+  /// 2 pi / A of a unit charge (the factor 20 covers the ratios seen in calibration).
   double estimated_error() const { return est_error_; }
 
   int order_xy() const { return pxy_; }           //!< Chebyshev nodes per box in x and y
@@ -154,6 +156,8 @@ class PeriodicFarField {
  private:
   static void interp_weights(double t, int p, const double *tab, double *s, double *ds);
   void apply(const Eigen::MatrixXd &w, Eigen::MatrixXd &phi) const;
+  void to_sym(const Eigen::MatrixXd &w, Eigen::MatrixXd *v) const;
+  void from_sym(const Eigen::MatrixXd *u, Eigen::MatrixXd &phi) const;
   int locate(std::size_t i, double x, double y, double z, double *tx, double *ty, double *tz) const;
   void interpolate(const Eigen::MatrixXd &phi, const double *x, const double *y, const double *z,
                    std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
@@ -169,7 +173,7 @@ class PeriodicFarField {
   double hz_ = 0;                             //!< box height
   double est_error_ = 0;                      //!< sampled relative kernel error
   double setup_s_ = 0;                        //!< set-up wall time
-  std::vector<Eigen::MatrixXd> ops_;          //!< M_o for offsets o = 0 .. nb-1 (target - source)
+  std::vector<Eigen::MatrixXd> ops_;          //!< blocks K_{o,s} at 4 o + s, offsets o = 0 .. nb-1
   std::vector<double> tab_xy_, tab_z_;        //!< T_k(t_i) at the Chebyshev nodes
 };
 
