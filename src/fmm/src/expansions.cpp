@@ -251,6 +251,56 @@ void Operators::m2l(const double *Ms, const Vec3 &R, double *Lt) const {
   }
 }
 
+namespace {
+
+constexpr int kMaxFixedOrder = 16;
+constexpr int kLanes = Operators::kBatch;
+
+// One row n of the batched M2L sum with n known at compile time: the n+1 outputs (m = 0..n)
+// of all lanes stay in registers while (k, l) run over the sources.
+template <int N>
+inline void m2l_row(int p, const double *__restrict Mr, const double *__restrict Mi, const double *__restrict Tr,
+                    const double *__restrict Ti, double *__restrict Ar, double *__restrict Ai) {
+  constexpr int W = kLanes;
+  double accr[N + 1][W], acci[N + 1][W];
+  for (int m = 0; m <= N; ++m)
+    for (int v = 0; v < W; ++v) {
+      accr[m][v] = Ar[idx(N, m) * W + v];
+      acci[m][v] = Ai[idx(N, m) * W + v];
+    }
+  for (int k = 0; k <= p - N; ++k)
+    for (int l = -k; l <= k; ++l) {
+      const double *__restrict mr = Mr + idx(k, l) * W, *__restrict mi = Mi + idx(k, l) * W;
+      const double *__restrict tr = Tr + idx(N + k, l) * W, *__restrict ti = Ti + idx(N + k, l) * W;
+      for (int m = 0; m <= N; ++m)
+#pragma omp simd
+        for (int v = 0; v < W; ++v) {
+          accr[m][v] += mr[v] * tr[m * W + v] - mi[v] * ti[m * W + v];
+          acci[m][v] += mr[v] * ti[m * W + v] + mi[v] * tr[m * W + v];
+        }
+    }
+  for (int m = 0; m <= N; ++m)
+    for (int v = 0; v < W; ++v) {
+      Ar[idx(N, m) * W + v] = accr[m][v];
+      Ai[idx(N, m) * W + v] = acci[m][v];
+    }
+}
+
+template <int N>
+inline void m2l_rows_from(int p, const double *Mr, const double *Mi, const double *Tr, const double *Ti, double *Ar,
+                          double *Ai) {
+  if (N > p) return;
+  m2l_row<N>(p, Mr, Mi, Tr, Ti, Ar, Ai);
+  if constexpr (N < kMaxFixedOrder) m2l_rows_from<N + 1>(p, Mr, Mi, Tr, Ti, Ar, Ai);
+}
+
+inline void m2l_rows(int p, const double *Mr, const double *Mi, const double *Tr, const double *Ti, double *Ar,
+                     double *Ai) {
+  m2l_rows_from<0>(p, Mr, Mi, Tr, Ti, Ar, Ai);
+}
+
+}  // namespace
+
 void Operators::m2l_batch(std::size_t count, const double *const *Ms, const Vec3 *R, double *Lt) const {
   constexpr int W = kBatch;
   const int p = p_, S = S_;
@@ -320,20 +370,23 @@ void Operators::m2l_batch(std::size_t count, const double *const *Ms, const Vec3
       }
     }
     // A_n^m += sum_{k <= p-n, l} M_k^l T_{n+k}^{m+l}, lane by lane
-    for (int n = 0; n <= p; ++n)
-      for (int k = 0; k <= p - n; ++k)
-        for (int l = -k; l <= k; ++l) {
-          const double *__restrict mr = Mr + idx(k, l) * W, *__restrict mi = Mi + idx(k, l) * W;
-          for (int m = 0; m <= n; ++m) {
-            const double *__restrict tr = Tr + idx(n + k, m + l) * W, *__restrict ti = Ti + idx(n + k, m + l) * W;
-            double *__restrict ar = Ar + idx(n, m) * W, *__restrict ai = Ai + idx(n, m) * W;
+    if (p <= kMaxFixedOrder)
+      m2l_rows(p, Mr, Mi, Tr, Ti, Ar, Ai);
+    else
+      for (int n = 0; n <= p; ++n)
+        for (int k = 0; k <= p - n; ++k)
+          for (int l = -k; l <= k; ++l) {
+            const double *__restrict mr = Mr + idx(k, l) * W, *__restrict mi = Mi + idx(k, l) * W;
+            for (int m = 0; m <= n; ++m) {
+              const double *__restrict tr = Tr + idx(n + k, m + l) * W, *__restrict ti = Ti + idx(n + k, m + l) * W;
+              double *__restrict ar = Ar + idx(n, m) * W, *__restrict ai = Ai + idx(n, m) * W;
 #pragma omp simd
-            for (int v = 0; v < W; ++v) {
-              ar[v] += mr[v] * tr[v] - mi[v] * ti[v];
-              ai[v] += mr[v] * ti[v] + mi[v] * tr[v];
+              for (int v = 0; v < W; ++v) {
+                ar[v] += mr[v] * tr[v] - mi[v] * ti[v];
+                ai[v] += mr[v] * ti[v] + mi[v] * tr[v];
+              }
             }
           }
-        }
   }
   double *lr = Lt, *li = Lt + S;
   for (int n = 0; n <= p; ++n) {

@@ -35,8 +35,8 @@ double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::d
 
 // Cost model (in units of one P2P particle pair) used to route cheap accepted pairs to P2P
 // and to balance the work partitions. Measured here: one M2L of order p costs about as much
-// as 0.7 (p+1)^3 P2P pairs (AVX-512 P2P, batched M2L), one L2P about (p+1)^2 / 4.
-double m2l_cost(int p) { return 0.7 * (p + 1.0) * (p + 1.0) * (p + 1.0); }
+// as 0.8 (p+1)^3 P2P pairs (AVX-512 P2P, batched M2L), one L2P about (p+1)^2 / 4.
+double m2l_cost(int p) { return 0.8 * (p + 1.0) * (p + 1.0) * (p + 1.0); }
 double l2p_cost(int p) { return 0.25 * (p + 1.0) * (p + 1.0); }
 }  // namespace
 
