@@ -1,0 +1,85 @@
+#!/usr/bin/env bash
+# Obtain the LAMMPS 4Feb2025 source from Debian's source package and unpack it.
+#
+#   fetch-lammps-debian.sh <cache-dir>
+#
+# Uses a private apt configuration (a deb-src entry for trixie, with the archive URI
+# taken from this machine's own apt sources), so the system's apt state is untouched.
+# The orig tarball is verified by sha256 (apt-get may fail on the .dsc and still exit 0).
+# The unpacked tree is moved into place only after every check passed, and a stamp file
+# written last marks it as complete: a later build trusts the tree only with the stamp.
+set -euo pipefail
+
+readonly DEB_VERSION="20250204+dfsg.1-2"
+readonly ORIG_TARBALL="lammps_20250204+dfsg.1.orig.tar.xz"
+readonly ORIG_SHA256="3671165bd52fad36734e0a9136c5bc5ecb225e03988f8c89aa13366a8b53b1c7"
+readonly TREE_NAME="lammps-20250204"
+
+fail() {
+  local step=$1; shift
+  {
+    echo "ERROR: obtaining LAMMPS from Debian failed at step '${step}': $*"
+    echo "  Instead, point the build at your own LAMMPS checkout (4Feb2025 or newer):"
+    echo "    cmake -S . -B build -D LAMMPS_SOURCE_DIR=/path/to/lammps"
+    echo "  or: make test LAMMPS_SOURCE_DIR=/path/to/lammps"
+  } >&2
+  exit 1
+}
+
+[[ $# -eq 1 ]] || fail "arguments" "usage: $0 <cache-dir>"
+cache=$1
+mkdir -p "$cache" || fail "create cache" "cannot create $cache"
+cache=$(cd "$cache" && pwd)
+tree="$cache/$TREE_NAME"
+stamp="$tree/.granular-charged-complete"
+
+if [[ -f $stamp ]]; then
+  echo "$tree"
+  exit 0
+fi
+# a tree without stamp is a leftover of an interrupted run: never trust it
+rm -rf "$tree"
+
+command -v apt-get >/dev/null || fail "apt-get" "apt-get not found (not a Debian system?)"
+
+mirror=${LAMMPS_DEBIAN_MIRROR:-}
+if [[ -z $mirror ]]; then
+  # first Debian archive URI (not the security archive) from the machine's apt sources
+  mirror=$( { cat /etc/apt/sources.list.d/*.sources 2>/dev/null | sed -n 's/^URIs:[[:space:]]*//p' | tr ' ' '\n'
+              cat /etc/apt/sources.list /etc/apt/sources.list.d/*.list 2>/dev/null \
+                | sed -n 's/^deb\(-src\)\?[[:space:]]\+\(\[[^]]*\][[:space:]]\+\)\?\([^[:space:]]\+\).*/\3/p'; } \
+            | grep -E '/debian/?$' | grep -v security | head -n 1 || true)
+fi
+[[ -n $mirror ]] || fail "find archive URI" \
+  "no Debian archive URI in /etc/apt/sources.list*; set LAMMPS_DEBIAN_MIRROR=http://<host>/debian"
+
+work="$cache/.fetch.$$"
+rm -rf "$work"
+trap 'rm -rf "$work"' EXIT
+mkdir -p "$work/lists/partial" "$work/download" "$work/unpack"
+echo "deb-src [signed-by=/usr/share/keyrings/debian-archive-keyring.gpg] $mirror trixie main" \
+  > "$work/sources.list"
+apt_opts=(-o "Dir::Etc::SourceList=$work/sources.list" -o "Dir::Etc::SourceParts=/dev/null"
+          -o "Dir::State::Lists=$work/lists" -o "APT::Get::List-Cleanup=0"
+          -o "APT::Sandbox::User=root")
+
+echo "-- LAMMPS: reading the trixie source index from $mirror" >&2
+apt-get "${apt_opts[@]}" -q update >&2 || fail "apt-get update (deb-src trixie at $mirror)" \
+  "the archive could not be reached"
+echo "-- LAMMPS: downloading source package lammps=$DEB_VERSION" >&2
+# apt-get may report a missing .dsc (HTTP 404) yet have the tarball: the checksum decides
+(cd "$work/download" && apt-get "${apt_opts[@]}" -q source --download-only "lammps=$DEB_VERSION" >&2) || true
+[[ -f "$work/download/$ORIG_TARBALL" ]] || fail "apt-get source lammps=$DEB_VERSION" \
+  "$ORIG_TARBALL was not downloaded"
+sum=$(sha256sum "$work/download/$ORIG_TARBALL" | cut -d' ' -f1)
+[[ $sum == "$ORIG_SHA256" ]] || fail "verify sha256 of $ORIG_TARBALL" \
+  "got $sum, expected $ORIG_SHA256"
+echo "-- LAMMPS: sha256 verified, unpacking" >&2
+tar -xJf "$work/download/$ORIG_TARBALL" -C "$work/unpack" || fail "unpack $ORIG_TARBALL" "tar failed"
+src=$(find "$work/unpack" -mindepth 1 -maxdepth 1 -type d | head -n 1)
+for f in cmake/CMakeLists.txt src/version.h src/GRANULAR/granular_model.h python/lammps/core.py; do
+  [[ -f "$src/$f" ]] || fail "check unpacked tree" "$f is missing"
+done
+mv "$src" "$tree"
+date -u +"%Y-%m-%dT%H:%M:%SZ $ORIG_SHA256" > "$stamp"
+echo "$tree"

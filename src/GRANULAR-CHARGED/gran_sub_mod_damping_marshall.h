@@ -1,0 +1,43 @@
+/* -*- c++ -*- ----------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+#ifdef GRAN_SUB_MOD_CLASS
+// clang-format off
+GranSubModStyle(marshall,GranSubModDampingMarshall,DAMPING);
+// clang-format on
+#else
+
+#ifndef GRAN_SUB_MOD_DAMPING_MARSHALL_H
+#define GRAN_SUB_MOD_DAMPING_MARSHALL_H
+
+#include "gran_sub_mod_damping.h"
+
+namespace LAMMPS_NS {
+namespace Granular_NS {
+
+  class GranSubModNormalJKRMarshall;
+
+  // Normal dashpot of Marshall (2009) for JKR contacts:
+  // eta_N = alpha(e) sqrt(m* k_N), k_N = 4/3 E* a, alpha from the restitution coefficient.
+  class GranSubModDampingMarshall : public GranSubModDamping {
+   public:
+    GranSubModDampingMarshall(class GranularModel *, class LAMMPS *);
+    void init() override;
+    double calculate_forces() override;
+
+   protected:
+    GranSubModNormalJKRMarshall *jkr;    // normal model, for E*
+    double alpha;                        // alpha(e)
+  };
+
+}    // namespace Granular_NS
+}    // namespace LAMMPS_NS
+
+#endif
+#endif

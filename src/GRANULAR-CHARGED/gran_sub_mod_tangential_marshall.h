@@ -1,0 +1,40 @@
+/* -*- c++ -*- ----------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+#ifdef GRAN_SUB_MOD_CLASS
+// clang-format off
+GranSubModStyle(marshall,GranSubModTangentialMarshall,TANGENTIAL);
+// clang-format on
+#else
+
+#ifndef GRAN_SUB_MOD_TANGENTIAL_MARSHALL_H
+#define GRAN_SUB_MOD_TANGENTIAL_MARSHALL_H
+
+#include "gran_sub_mod_tangential.h"
+
+namespace LAMMPS_NS {
+namespace Granular_NS {
+
+  // Sliding spring-dashpot-slider of Marshall (2009): k_T = 8 G* a, eta_T = eta_N,
+  // slip at mu |F_ne + 2 F_C|. The Mindlin machinery of the built-in model (history of the
+  // tangential displacement, frame rotation, slip rescaling) with G* taken from the normal
+  // model's materials (correct for unlike types) and the damping ratio fixed to 1.
+  class GranSubModTangentialMarshall : public GranSubModTangentialMindlin {
+   public:
+    GranSubModTangentialMarshall(class GranularModel *, class LAMMPS *);
+    void coeffs_to_local() override;
+    void mix_coeffs(double *, double *) override;
+    void init() override;
+  };
+
+}    // namespace Granular_NS
+}    // namespace LAMMPS_NS
+
+#endif
+#endif

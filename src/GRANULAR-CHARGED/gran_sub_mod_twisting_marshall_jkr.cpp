@@ -1,0 +1,83 @@
+/* ----------------------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+#include "gran_sub_mod_twisting_marshall_jkr.h"
+
+#include "error.h"
+#include "gran_sub_mod_normal.h"
+#include "gran_sub_mod_tangential.h"
+#include "granular_model.h"
+
+#include <cmath>
+
+using namespace LAMMPS_NS;
+using namespace Granular_NS;
+
+static constexpr double THREEPI_16 = 0.5890486225480862;    // 3 pi / 16
+
+/* ---------------------------------------------------------------------- */
+
+GranSubModTwistingMarshallJKR::GranSubModTwistingMarshallJKR(GranularModel *gm, LAMMPS *lmp) :
+    GranSubModTwisting(gm, lmp), k_tang(0.0), mu_tang(0.0)
+{
+  num_coeffs = 0;
+  size_history = 1;
+  contact_radius_flag = 1;
+  // the twist angle (integral of (w_i - w_j) . n) is symmetric in i and j: copy it when a
+  // neighbor rebuild swaps the pair (LAMMPS's default negation is wrong for it, as in the
+  // built-in twisting marshall)
+  nondefault_history_transfer = 1;
+  transfer_history_factor = new double[size_history];
+  transfer_history_factor[0] = +1.0;
+}
+
+/* ----------------------------------------------------------------------
+   needs a tangential model whose stiffness is 8 G* per unit contact radius
+   (marshall or the mindlin family), so that k_T = 8 G* a
+------------------------------------------------------------------------- */
+
+void GranSubModTwistingMarshallJKR::init()
+{
+  const std::string &tname = gm->tangential_model->name;
+  if (tname != "marshall" && tname.rfind("mindlin", 0) != 0)
+    error->all(FLERR,
+               "Twisting marshall/jkr requires tangential model marshall or mindlin "
+               "(stiffness 8 G* a), not {}",
+               tname);
+  k_tang = gm->tangential_model->get_k();
+  mu_tang = gm->tangential_model->get_mu();
+}
+
+/* ----------------------------------------------------------------------
+   M_t = -k_tw phi - eta_tw omega_T,  k_tw = k_T a^2 / 2 = 4 G* a^3,
+   eta_tw = eta_T a^2 / 2                        (Marshall 2009, eqs. 29-32)
+   |M_t| <= M_crit = 3 pi a F_crit / 16, F_crit = mu |F_ne + 2 F_C|   (paper eq. 4)
+   On slip the moment keeps the sign of the trial moment and the twist angle is reset to the
+   value that produces exactly M_crit (as the sliding model does).
+------------------------------------------------------------------------- */
+
+void GranSubModTwistingMarshallJKR::calculate_forces()
+{
+  const double a = gm->contact_radius;
+  const double k = 0.5 * k_tang * a * a * a;
+  const double damp = 0.5 * gm->tangential_model->get_damp() * a * a;
+  const double Mcrit = THREEPI_16 * a * mu_tang * gm->normal_model->get_fncrit();
+
+  double &phi = gm->history[history_index];
+  double angle = phi;
+  if (gm->history_update) angle += gm->magtwist * gm->dt;
+
+  double moment = -k * angle - damp * gm->magtwist;
+  if (fabs(moment) > Mcrit) {
+    moment = (moment > 0.0) ? Mcrit : -Mcrit;
+    angle = (k > 0.0) ? -(moment + damp * gm->magtwist) / k : 0.0;
+  }
+  gm->magtortwist = moment;
+  if (gm->history_update) phi = angle;
+}

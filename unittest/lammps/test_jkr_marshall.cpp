@@ -1,0 +1,370 @@
+/* GRANULAR-CHARGED: jkr/marshall and companions (pair_style granular, fix wall/gran),
+   tested against the closed forms of physics.md sec. 1 (JKR relations written again,
+   independently, in gc_testing.h). Units si: r_p = 1 um, E = 2e8 Pa, nu = 0.33,
+   gamma = 0.01 J/m^2, rho = 2500 kg/m^3 (the paper's Table 1). */
+#include "gc_testing.h"
+
+#include "exceptions.h"
+#include "gtest/gtest.h"
+
+#include <cmath>
+#include <regex>
+#include <string>
+
+using gctest::JKR;
+using gctest::Lmp;
+
+namespace {
+
+constexpr double RP = 1.0e-6, EMOD = 2.0e8, NU = 0.33, GAMMA = 0.01, RHO = 2500.0, MU = 0.3;
+const double ESTAR_PAIR = EMOD / (2.0 * (1.0 - NU * NU));     // E* of two like spheres
+const double GSTAR_PAIR = EMOD / (4.0 * (2.0 - NU) * (1.0 + NU));
+const double MASS = 4.0 / 3.0 * M_PI * RP * RP * RP * RHO;
+
+std::string contact_model(double e, double gamma = GAMMA, const std::string &extra = "")
+{
+  return fmt::format("jkr/marshall {} {} {} {} damping marshall tangential marshall {} {}", EMOD,
+                     e, NU, gamma, MU, extra);
+}
+
+// two spheres on the x axis: atom 1 at the origin, atom 2 at x = gap + 2 r_p
+void two_spheres(Lmp &l, double e, const std::string &extra = "", double gamma = GAMMA,
+                 const std::string &newton = "off")
+{
+  l.cmds({"units si", "atom_style sphere", "atom_modify map array", "boundary f f f",
+          "newton " + newton, "comm_modify vel yes",
+          "region box block -1e-5 1e-5 -1e-5 1e-5 -1e-5 1e-5", "create_box 1 box",
+          "create_atoms 1 single 0 0 0", fmt::format("create_atoms 1 single {} 0 0", 2 * RP),
+          fmt::format("set type 1 diameter {}", 2 * RP), fmt::format("set type 1 density {}", RHO),
+          "pair_style granular", "pair_coeff * * " + contact_model(e, gamma, extra),
+          "neighbor 2e-7 bin", "timestep 1e-10"});
+}
+
+// place atom 2 at overlap delta and evaluate forces without moving anything
+double force_at(Lmp &l, double delta)
+{
+  l.cmd(fmt::format("set atom 2 x {:.17g}", 2 * RP - delta));
+  l.cmd("run 0 post no");
+  return -l.var("fx[1]");    // > 0 repulsive: force on atom 1 points to -x
+}
+
+std::string error_of(const std::vector<std::string> &cmds)
+{
+  Lmp l;
+  try {
+    l.cmds(cmds);
+  } catch (LAMMPS_NS::LAMMPSException &e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+}    // namespace
+
+// 1. quasi-static loading/unloading; contact hysteresis; the three check points
+TEST(JKRMarshall, QuasiStaticCheckPoints)
+{
+  Lmp l;
+  two_spheres(l, 1.0);
+  const JKR jkr{RP / 2, ESTAR_PAIR, GAMMA};
+  const double FC = jkr.FC(), dC = jkr.deltaC();
+
+  // the test-side closed forms themselves hit the table of physics.md
+  EXPECT_NEAR(JKR::delta_of_ahat(1.0), 1.21141, 5e-6);
+  EXPECT_NEAR(JKR::delta_of_ahat(std::pow(2.0, -2.0 / 3.0)), -0.48075, 5e-6);
+  EXPECT_NEAR(JKR::delta_of_ahat(std::pow(6.0, -2.0 / 3.0)), -1.0, 1e-12);
+  EXPECT_NEAR(JKR::force_of_ahat(std::pow(6.0, -2.0 / 3.0)), -5.0 / 9.0, 1e-12);
+
+  // approach: no contact for delta < 0
+  for (double dd : {-0.9, -0.5, -0.1, -1e-3}) EXPECT_EQ(force_at(l, dd * dC), 0.0) << dd;
+  // contact forms at delta = 0 (JKR snap-in: a = (2/3)^(2/3) a_0, F < 0)
+  EXPECT_NEAR(force_at(l, 1e-9 * dC) / FC, JKR::force_of_ahat(std::pow(2.0 / 3.0, 2.0 / 3.0)), 1e-6);
+  // loading then unloading through the check points: 1e-6 relative to F_C is what the closed
+  // form of the contact radius (double precision, cube and square roots) delivers away from the
+  // double root at separation.
+  for (double dd : {0.5, 2.0, 3.0}) EXPECT_NEAR(force_at(l, dd * dC) / FC, jkr.force(dd * dC) / FC, 1e-6);
+  const double zero_load = JKR::delta_of_ahat(1.0);
+  const double pull_off = JKR::delta_of_ahat(std::pow(2.0, -2.0 / 3.0));
+  EXPECT_NEAR(force_at(l, zero_load * dC) / FC, 0.0, 1e-6);
+  EXPECT_NEAR(force_at(l, pull_off * dC) / FC, -1.0, 1e-6);
+  EXPECT_NEAR(force_at(l, -0.9 * dC) / FC, jkr.force(-0.9 * dC) / FC, 1e-6);
+  // just before separation: F -> -5/9 F_C; near the double root a - a_min ~ sqrt(1 - |delta|/delta_C),
+  // so at 1 - 1e-10 the force is within ~1e-4 F_C of -5/9
+  EXPECT_NEAR(force_at(l, -(1.0 - 1e-10) * dC) / FC, -5.0 / 9.0, 1e-4);
+  // beyond delta_C the contact is gone, and does not re-form in tension
+  EXPECT_EQ(force_at(l, -1.001 * dC), 0.0);
+  EXPECT_EQ(force_at(l, -0.5 * dC), 0.0);
+  EXPECT_NE(force_at(l, 0.1 * dC), 0.0);
+}
+
+// 2. pull-off: the largest tensile force on unloading is F_C = 3 pi gamma R
+TEST(JKRMarshall, PullOffForce)
+{
+  Lmp l;
+  two_spheres(l, 1.0);
+  const JKR jkr{RP / 2, ESTAR_PAIR, GAMMA};
+  force_at(l, 2.0 * jkr.deltaC());
+  double fmin = 0.0;
+  // fine sweep around the minimum; F is quadratic there, so a step of 1e-3 delta_C resolves
+  // the minimum to ~1e-6 F_C
+  for (double dd = 0.0; dd >= -0.99; dd -= 1e-3) fmin = std::min(fmin, force_at(l, dd * jkr.deltaC()));
+  EXPECT_NEAR(fmin / (3.0 * M_PI * GAMMA * RP / 2), -1.0, 1e-5);
+}
+
+// 5. the wall: same law with R = r_p; pull-off 3 pi gamma r_p
+TEST(JKRMarshall, WallForceLaw)
+{
+  Lmp l;
+  l.cmds({"units si", "atom_style sphere", "atom_modify map array", "boundary p p f",
+          "comm_modify vel yes", "region box block 0 1e-5 0 1e-5 0 1e-5", "create_box 1 box",
+          fmt::format("create_atoms 1 single 5e-6 5e-6 {}", RP),
+          fmt::format("set type 1 diameter {}", 2 * RP), fmt::format("set type 1 density {}", RHO),
+          "pair_style granular", "pair_coeff * * " + contact_model(1.0), "neighbor 2e-7 bin",
+          "timestep 1e-10",
+          "fix floor all wall/gran granular " + contact_model(1.0) + " zplane 0.0 NULL"});
+  const JKR wall{RP, EMOD / (2.0 * (1.0 - NU * NU)), GAMMA};    // R = r_p, E* of like materials
+  auto fz_at = [&](double delta) {
+    l.cmd(fmt::format("set atom 1 z {:.17g}", RP - delta));
+    l.cmd("run 0 post no");
+    return l.var("fz[1]");
+  };
+  EXPECT_EQ(fz_at(-0.5 * wall.deltaC()), 0.0);
+  double fmin = 0.0;
+  for (double dd : {1.5, 1.0, 0.3}) EXPECT_NEAR(fz_at(dd * wall.deltaC()) / wall.FC(), wall.force(dd * wall.deltaC()) / wall.FC(), 1e-6);
+  for (double dd = 0.0; dd >= -0.99; dd -= 1e-3) fmin = std::min(fmin, fz_at(dd * wall.deltaC()));
+  EXPECT_NEAR(fmin / (3.0 * M_PI * GAMMA * RP), -1.0, 1e-5);
+  EXPECT_NEAR(fz_at(-(1.0 - 1e-10) * wall.deltaC()) / wall.FC(), -5.0 / 9.0, 1e-4);
+  EXPECT_EQ(fz_at(-1.001 * wall.deltaC()), 0.0);
+}
+
+// ---- collisions ---------------------------------------------------------------------------
+
+namespace {
+struct Collision {
+  double e_apparent;    // |v_rel after| / |v_rel before|
+  double ke_before, ke_after;
+  bool stuck;
+};
+
+Collision collide(double e, double v, double gamma = GAMMA, double dt = 2e-10, const std::string &newton = "off")
+{
+  Lmp l;
+  two_spheres(l, e, "", gamma, newton);
+  l.cmd(fmt::format("set atom 2 x {:.17g}", 2 * RP + 1e-8));
+  l.cmd(fmt::format("velocity all set NULL 0 0 units box"));
+  l.cmd(fmt::format("set atom 1 vx {}", 0.5 * v));
+  l.cmd(fmt::format("set atom 2 vx {}", -0.5 * v));
+  l.cmds({"fix integrate all nve/sphere", fmt::format("timestep {}", dt),
+          "compute ke all ke", "thermo_style custom step c_ke", "thermo 0", "run 0 post no"});
+  Collision c{};
+  c.ke_before = l.var("c_ke");
+  // run until the spheres separate beyond the break distance, or long enough to call it stuck
+  const double dC = JKR{RP / 2, ESTAR_PAIR, gamma}.deltaC();
+  c.stuck = true;
+  for (int chunk = 0; chunk < 400; ++chunk) {
+    l.cmd("run 200 post no");
+    if (l.var("x[2]-x[1]") > 2 * RP + 1.5 * dC + 1e-9 && l.var("vx[2]-vx[1]") > 0) {
+      c.stuck = false;
+      break;
+    }
+  }
+  c.e_apparent = l.var("vx[2]-vx[1]") / v;
+  c.ke_after = l.var("c_ke");
+  return c;
+}
+
+// energy needed to pull a JKR contact from delta = 0 to -delta_C: -int F d(delta)
+double separation_work(const JKR &jkr)
+{
+  const double amin = std::pow(6.0, -2.0 / 3.0), a0 = JKR::ahat_of_delta(0.0);
+  double w = 0.0;
+  const int n = 20000;
+  for (int k = 0; k < n; ++k) {    // midpoint rule in a-hat: d(delta) = delta'(a) da
+    const double a = amin + (k + 0.5) * (a0 - amin) / n;
+    const double ddel = std::cbrt(6.0) * (4.0 * a - 2.0 / 3.0 / std::sqrt(a));
+    w -= JKR::force_of_ahat(a) * ddel * (a0 - amin) / n;
+  }
+  return w * jkr.FC() * jkr.deltaC();
+}
+}    // namespace
+
+// 3. head-on collisions: restitution tends to e above the sticking speed; capture below it
+TEST(JKRMarshall, RestitutionAndCapture)
+{
+  // Inertia-dominated limit: gamma = 1e-3 J/m^2 and v = 50 m/s (~700x the capture speed).
+  // The adhesive term of the JKR force decays only like (delta/delta_C)^(-3/4) ~ v^(-0.6),
+  // so at the paper's gamma = 0.01 the apparent e stays below e even far above capture
+  // (measured: e = 0.3 -> 0.278, 0.7 -> 0.690, 0.9 -> 0.897 at 50 m/s; table in the doc);
+  // the 3% allowance covers the remaining adhesive deficit here (< 2.3% at e = 0.3).
+  for (double e : {0.3, 0.7, 0.9}) {
+    auto c = collide(e, 50.0, 1e-3, 2e-11);
+    EXPECT_FALSE(c.stuck);
+    EXPECT_NEAR(c.e_apparent / e, 1.0, 0.03) << "e = " << e;
+    std::printf("[ restitution ] e = %.2f  v = 50 m/s  gamma = 1e-3  apparent e = %.4f\n", e, c.e_apparent);
+  }
+  // without adhesion the damping model reproduces e itself: 0.2% covers the time step
+  for (double e : {0.3, 0.7, 0.9}) EXPECT_NEAR(collide(e, 5.0, 0.0, 2e-11).e_apparent / e, 1.0, 2e-3);
+  EXPECT_TRUE(collide(0.7, 0.05).stuck);
+
+  // capture speed by bisection, vs the energy balance (1/2) m* (e v_c)^2 = W_sep
+  double lo = 0.05, hi = 5.0;
+  for (int it = 0; it < 12; ++it) {
+    const double mid = std::sqrt(lo * hi);
+    (collide(0.7, mid).stuck ? lo : hi) = mid;
+  }
+  const JKR jkr{RP / 2, ESTAR_PAIR, GAMMA};
+  const double mstar = MASS / 2, W = separation_work(jkr);
+  const double v_estimate = std::sqrt(2.0 * W / mstar) / 0.7;
+  std::printf("[ capture ] e = 0.7: numerical v_c = %.4f m/s, energy balance %.4f m/s, W_sep = "
+              "%.4g J = %.4f F_C delta_C\n",
+              hi, v_estimate, W, W / (jkr.FC() * jkr.deltaC()));
+  // the estimate ignores the extra dissipation of the snap-in and of damping in the tensile
+  // branch, so it can only be an order-of-magnitude guide: require agreement within 2x
+  EXPECT_GT(hi / v_estimate, 0.5);
+  EXPECT_LT(hi / v_estimate, 2.0);
+}
+
+// 6. no damping: a collision conserves energy (gamma = 0), or loses exactly the separation
+// work of the adhesive hysteresis (gamma > 0)
+TEST(JKRMarshall, EnergyBalanceWithoutDamping)
+{
+  // dt = 2e-11 s ~ t_c/3000: velocity Verlet's error, dominated by the force jumps at contact
+  // formation and break (~F_C v dt), is < 2e-4 of the kinetic energy
+  auto hertz = collide(1.0, 2.0, 0.0, 2e-11);
+  EXPECT_FALSE(hertz.stuck);
+  EXPECT_NEAR(hertz.ke_after / hertz.ke_before, 1.0, 1e-3);
+  auto jkrc = collide(1.0, 2.0, GAMMA, 2e-11);
+  EXPECT_FALSE(jkrc.stuck);
+  const double W = separation_work(JKR{RP / 2, ESTAR_PAIR, GAMMA});
+  std::printf("[ energy ] KE before %.6g J, after %.6g J, W_sep %.6g J\n", jkrc.ke_before,
+              jkrc.ke_after, W);
+  EXPECT_NEAR((jkrc.ke_before - jkrc.ke_after) / jkrc.ke_before, W / jkrc.ke_before, 1e-3);
+}
+
+// 4. sliding, twisting, rolling under prescribed motion at a loaded contact (no damping)
+namespace {
+void loaded_pair(Lmp &l, double delta, const std::string &extra)
+{
+  two_spheres(l, 1.0, extra);
+  l.cmd(fmt::format("set atom 2 x {:.17g}", 2 * RP - delta));
+  l.cmds({"group one id 1", "group two id 2", "timestep 1e-9"});
+}
+double ahat_at(double dd) { return JKR::ahat_of_delta(dd); }
+}    // namespace
+
+TEST(JKRMarshall, SlidingSpringAndLimit)
+{
+  Lmp l;
+  const JKR jkr{RP / 2, ESTAR_PAIR, GAMMA};
+  loaded_pair(l, jkr.deltaC(), "");
+  const double a = ahat_at(1.0) * jkr.a0();
+  const double kT = 8.0 * GSTAR_PAIR * a;    // Marshall eq. 24
+  const double Fne = jkr.force(jkr.deltaC());
+  const double Fcrit = MU * std::fabs(Fne + 2.0 * jkr.FC());
+  const double vt = 0.02;    // m/s; u grows 2e-11 m per step, slip after ~100 steps
+  l.cmds({"fix hold one move linear 0 0 0", fmt::format("fix slide two move linear 0 {} 0", vt)});
+  l.cmd("run 0 post no");
+  for (int step = 1; step <= 300; ++step) {
+    l.cmd("run 1 post no");
+    const double u = l.var("y[2]-y[1]");
+    // tangential part of the force on atom 1 (normal part removed with the current normal)
+    const double dx = l.var("x[1]-x[2]"), dy = l.var("y[1]-y[2]");
+    const double r = std::hypot(dx, dy), nx = dx / r, ny = dy / r;
+    const double fx = l.var("fx[1]"), fy = l.var("fy[1]");
+    const double fn = fx * nx + fy * ny;
+    const double ft = std::hypot(fx - fn * nx, fy - fn * ny);
+    const double expect = std::min(kT * u, Fcrit);
+    // u is integrated by the model from v_t dt, the test reads it from positions: they agree
+    // to the first order in the normal's rotation (u/r ~ 1e-3), hence 1e-3 relative to F_crit
+    EXPECT_NEAR(ft / Fcrit, expect / Fcrit, 2e-3) << "step " << step;
+  }
+}
+
+TEST(JKRMarshall, TwistingSpringAndLimit)
+{
+  Lmp l;
+  const JKR jkr{RP / 2, ESTAR_PAIR, GAMMA};
+  loaded_pair(l, jkr.deltaC(), "twisting marshall/jkr");
+  const double a = ahat_at(1.0) * jkr.a0();
+  const double ktw = 0.5 * 8.0 * GSTAR_PAIR * a * a * a;    // k_T a^2 / 2
+  const double Fcrit = MU * std::fabs(jkr.force(jkr.deltaC()) + 2.0 * jkr.FC());
+  const double Mcrit = 3.0 * M_PI * a * Fcrit / 16.0;    // paper eq. 4
+  const double omega = 2.0 * Mcrit / ktw / 200e-9;          // twist to 2 M_crit in 200 steps
+  l.cmds({"fix hold one move linear 0 0 0",
+          fmt::format("fix twist two move rotate {:.17g} 0 0 1 0 0 {:.17g}", 2 * RP - jkr.deltaC(),
+                      2.0 * M_PI / omega)});
+  l.cmd("run 0 post no");
+  for (int step = 1; step <= 300; ++step) {
+    l.cmd("run 1 post no");
+    const double phi = omega * step * 1e-9;
+    const double M = std::fabs(l.torque(1, 0));
+    EXPECT_NEAR(M / Mcrit, std::min(ktw * phi, Mcrit) / Mcrit, 1e-6) << "step " << step;
+  }
+}
+
+TEST(JKRMarshall, RollingSpringAndLimit)
+{
+  Lmp l;
+  const JKR jkr{RP / 2, ESTAR_PAIR, GAMMA};
+  const double theta = 0.01;
+  loaded_pair(l, jkr.deltaC(), fmt::format("rolling marshall {}", theta));
+  const double ah = ahat_at(1.0);
+  const double kR = 4.0 * jkr.FC() * std::pow(ah, 1.5);    // paper eq. 3
+  const double Reff = RP / 2;
+  const double Mcrit = kR * theta * Reff;                   // paper eq. 4
+  // opposite spins about z: pure rolling (R_i w_i + R_j w_j = 0, no sliding, no twist);
+  // xi = R (w_1 - w_2) t = 2 R w t reaches 2 theta R in 200 steps
+  const double omega = 2.0 * theta / (2.0 * 200e-9);
+  l.cmds({fmt::format("fix spin1 one move rotate 0 0 0 0 0 1 {:.17g}", 2.0 * M_PI / omega),
+          fmt::format("fix spin2 two move rotate {:.17g} 0 0 0 0 -1 {:.17g}", 2 * RP - jkr.deltaC(),
+                      2.0 * M_PI / omega)});
+  l.cmd("run 0 post no");
+  for (int step = 1; step <= 300; ++step) {
+    l.cmd("run 1 post no");
+    const double xi = Reff * 2.0 * omega * step * 1e-9;
+    const double M = std::hypot(l.torque(1, 0), l.torque(1, 1), l.torque(1, 2));
+    const double ft = std::hypot(l.var("fy[1]"), l.var("fz[1]"));
+    EXPECT_LT(ft, 1e-9 * jkr.FC()) << "no sliding force in pure rolling";
+    EXPECT_NEAR(M / Mcrit, std::min(kR * xi, Mcrit) / Mcrit, 1e-6) << "step " << step;
+  }
+}
+
+// 8. bad input: each refused with a message naming the model and the value
+TEST(JKRMarshall, BadInput)
+{
+  const std::vector<std::string> base = {
+      "units si", "atom_style sphere", "region box block 0 1e-5 0 1e-5 0 1e-5",
+      "create_box 1 box", "pair_style granular"};
+  auto err = [&](const std::string &coeff) {
+    auto c = base;
+    c.push_back("pair_coeff * * " + coeff);
+    return error_of(c);
+  };
+  auto expect_match = [](const std::string &msg, const std::string &re) {
+    EXPECT_TRUE(std::regex_search(msg, std::regex(re))) << "message: " << msg << "\nexpected: " << re;
+  };
+  const std::string tail = " damping marshall tangential marshall 0.3";
+  expect_match(err("jkr/marshall 2e8 0.7 0.33"), "Illegal|argument|Insufficient|Expected");
+  expect_match(err("jkr/marshall 2e8 0.7 abc 0.01" + tail), "Expected floating point.*abc");
+  expect_match(err("jkr/marshall 0 0.7 0.33 0.01" + tail), "jkr/marshall.*Young's modulus must be > 0, got 0");
+  expect_match(err("jkr/marshall -2e8 0.7 0.33 0.01" + tail), "Young's modulus must be > 0");
+  expect_match(err("jkr/marshall 2e8 0.7 0.6 0.01" + tail), "Poisson's ratio must be in \\(-1, 0.5\\], got 0.6");
+  expect_match(err("jkr/marshall 2e8 0.7 -1 0.01" + tail), "Poisson's ratio");
+  expect_match(err("jkr/marshall 2e8 0.7 0.33 -0.01" + tail), "surface energy must be >= 0, got -0.01");
+  expect_match(err("jkr/marshall 2e8 1.5 0.33 0.01" + tail), "restitution coefficient must be in \\[0, 1\\], got 1.5");
+  expect_match(err("jkr/marshall 2e8 -0.1 0.33 0.01" + tail), "restitution coefficient");
+  expect_match(err("jkr/marshall 2e8 0.7 0.33 0.01 damping marshall tangential marshall -0.3"),
+               "marshall tangential model, friction coefficient must be >= 0, got -0.3");
+  expect_match(err("jkr/marshall 2e8 0.7 0.33 0.01" + tail + " rolling marshall 0"),
+               "marshall rolling model, theta_crit must be > 0, got 0");
+  expect_match(err("jkr 2e8 0.7 0.33 0.01 damping marshall tangential marshall 0.3"),
+               "Damping marshall requires normal model jkr/marshall.*not jkr");
+  expect_match(err("hertz/material 2e8 0.7 0.33 damping viscoelastic tangential marshall 0.3 "
+                   "rolling marshall 0.01"),
+               "Rolling marshall requires normal model jkr/marshall");
+  expect_match(err("jkr/marshall 2e8 0.7 0.33 0.01 damping marshall twisting marshall/jkr"),
+               "Must specify tangential granular model");
+  expect_match(err("jkr/marshall 2e8 0.7 0.33 0.01 damping marshall tangential linear_history "
+                   "1e3 1.0 0.3 twisting marshall/jkr"),
+               "Twisting marshall/jkr requires tangential model marshall or mindlin.*linear_history");
+}

@@ -1,0 +1,3 @@
+# one gc_lammps_test() per test file; see ../CMakeLists.txt
+gc_lammps_test(test_jkr_marshall SOURCES test_jkr_marshall.cpp)
+gc_lammps_test(test_jkr_marshall_reproducible NP 1 2 SOURCES test_jkr_marshall_reproducible.cpp)
