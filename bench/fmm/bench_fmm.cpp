@@ -25,10 +25,12 @@ struct Particles {
   std::vector<double> x, y, z, q;
 };
 
+double width(std::size_t n) { return 28.0 * std::sqrt(double(n) / 2000.0); }
+
 Particles deposition(std::size_t n, unsigned seed) {
-  // same recipe as unittest/fmm/fmm_test_util.hpp: lx = ly = 28, 90 % in a bed of phi ~ 0.3,
-  // 10 % spread up to z = 160, equal charges
-  const double lx = 28, ly = 28, zmax = 160;
+  // same recipe as unittest/fmm/fmm_test_util.hpp: lx = ly = 28 sqrt(N / 2000) (28 at N = 2000),
+  // 90 % in a bed of phi ~ 0.3 (about 32 high), 10 % spread up to z = 160, equal charges
+  const double lx = width(n), ly = lx, zmax = 160;
   std::mt19937_64 g(seed);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const std::size_t nbed = n * 9 / 10;
@@ -100,6 +102,7 @@ int main(int argc, char **argv) {
   const bool periodic = geom == "deposition";
   std::printf("# geometry %s, %s\n", geom.c_str(),
               periodic ? ("Periodic2D, FarField::None, images " + std::to_string(images)).c_str() : "free space");
+  std::printf("# deposition box: lx = ly = 28 sqrt(N/2000), z up to 160\n");
   std::printf("%8s %8s %5s %6s %5s %6s %10s %10s %10s %10s %10s %10s %10s %11s %9s\n", "N", "acc", "p", "theta",
               "leaf", "levels", "m2l", "p2p_pairs", "t_build", "t_eval", "t_up", "t_m2l", "t_p2p", "t_down", "err_F");
   using Clock = std::chrono::steady_clock;
@@ -125,7 +128,7 @@ int main(int argc, char **argv) {
       for (int ix = -k; ix <= k; ++ix)
         for (int iy = -k; iy <= k; ++iy)
           p2p(idx.size(), tx.data(), ty.data(), tz.data(), n, P.x.data(), P.y.data(), P.z.data(), P.q.data(),
-              ix * 28.0, iy * 28.0, 0.0, rp.data(), rx.data(), ry.data(), rz.data());
+              ix * width(n), iy * width(n), 0.0, rp.data(), rx.data(), ry.data(), rz.data());
     }
     for (double acc : accs)
       for (int order : orders)
@@ -139,7 +142,7 @@ int main(int argc, char **argv) {
           o.boundary = periodic ? Boundary::Periodic2D : Boundary::Free;
           o.farfield = FarField::None;
           Solver s(o);
-          if (periodic) s.set_box(0.0, 0.0, 28.0, 28.0);
+          if (periodic) s.set_box(0.0, 0.0, width(n), width(n));
           auto t0 = Clock::now();
           s.build(n, P.x.data(), P.y.data(), P.z.data());
           const double tb = std::chrono::duration<double>(Clock::now() - t0).count();

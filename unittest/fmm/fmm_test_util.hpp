@@ -40,11 +40,16 @@ inline Particles random_cube(std::size_t n, unsigned seed, double side = 1.0) {
   return p;
 }
 
-// Deposition-like geometry: box lx = ly = 28 (particle radius 1), 90% of the particles in a
-// dense bed of volume fraction ~0.3 at the bottom, 10% spread up to z = 160. Equal charges.
+// Deposition-like geometry: box lx = ly = 28 for N = 2000 (particle radius 1), 90% of the
+// particles in a dense bed of volume fraction ~0.3 at the bottom (about 32 high), 10% spread
+// up to z = 160. Equal charges. For other N the box width scales as sqrt(N / 2000) so that
+// the bed keeps its height (lx <= 0: automatic).
 // Bed particles are placed at random with a minimum separation of 1.0 (not a real packing,
 // but the same density and the same short distances that matter for the P2P/M2L balance).
-inline Particles deposition(std::size_t n, unsigned seed, double lx = 28.0, double ly = 28.0, double zmax = 160.0) {
+inline double deposition_width(std::size_t n) { return 28.0 * std::sqrt(double(n) / 2000.0); }
+inline Particles deposition(std::size_t n, unsigned seed, double lx = 0.0, double ly = 0.0, double zmax = 160.0) {
+  if (lx <= 0.0) lx = deposition_width(n);
+  if (ly <= 0.0) ly = lx;
   std::mt19937_64 g(seed);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const std::size_t nbed = (n * 9) / 10;

@@ -1,0 +1,122 @@
+// P2P kernel of gcfmm against a plain long-double double loop, and the direct sums.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "gcfmm/kernels.hpp"
+#include "fmm_test_util.hpp"
+
+using namespace gcfmm;
+
+namespace {
+// reference: long double, exact sqrt, no vectorisation tricks
+void ref_sum(const gcfmm_test::Particles &t, const gcfmm_test::Particles &s, double sx, double sy, double sz,
+             std::vector<double> &p, std::vector<double> &ex, std::vector<double> &ey, std::vector<double> &ez) {
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    long double a = 0, b = 0, c = 0, d = 0;
+    for (std::size_t j = 0; j < s.size(); ++j) {
+      const long double dx = (long double)t.x[i] - s.x[j] - sx, dy = (long double)t.y[i] - s.y[j] - sy,
+                        dz = (long double)t.z[i] - s.z[j] - sz;
+      const long double r2 = dx * dx + dy * dy + dz * dz;
+      if (r2 == 0) continue;
+      const long double r = std::sqrt(r2);
+      a += s.q[j] / r;
+      b += s.q[j] * dx / (r * r2);
+      c += s.q[j] * dy / (r * r2);
+      d += s.q[j] * dz / (r * r2);
+    }
+    p[i] = (double)a;
+    ex[i] = (double)b;
+    ey[i] = (double)c;
+    ez[i] = (double)d;
+  }
+}
+}  // namespace
+
+// Every target/source count from 0 to 19 (covers the 8-wide masked tails) plus a big one.
+// Tolerance: double round-off over <= 1000 terms with cancellation between signs, relative to
+// the sum of |terms| ~ 1e-13 (the 1/sqrt refinement itself is good to ~1e-16).
+TEST(P2P, MatchesLongDoubleReference) {
+  auto src = gcfmm_test::random_cube(1000, 21);
+  auto tgt = gcfmm_test::random_cube(50, 22);
+  for (std::size_t nt : {0u, 1u, 3u, 7u, 8u, 9u, 15u, 16u, 17u, 50u})
+    for (std::size_t ns : {0u, 1u, 5u, 8u, 13u, 19u, 1000u}) {
+      gcfmm_test::Particles t = tgt, s = src;
+      t.resize(nt);
+      s.resize(ns);
+      std::vector<double> p(nt, 0), ex(nt, 0), ey(nt, 0), ez(nt, 0), rp(nt), rx(nt), ry(nt), rz(nt);
+      p2p(nt, t.x.data(), t.y.data(), t.z.data(), ns, s.x.data(), s.y.data(), s.z.data(), s.q.data(), 0.3, -0.2,
+          0.1, p.data(), ex.data(), ey.data(), ez.data());
+      ref_sum(t, s, 0.3, -0.2, 0.1, rp, rx, ry, rz);
+      for (std::size_t i = 0; i < nt; ++i) {
+        const double scale = 1.0 + std::abs(rp[i]) + std::abs(rx[i]) + std::abs(ry[i]) + std::abs(rz[i]);
+        EXPECT_LT(std::abs(p[i] - rp[i]), 1e-12 * scale * std::sqrt(double(ns) + 1.0));
+        EXPECT_LT(std::abs(ex[i] - rx[i]) + std::abs(ey[i] - ry[i]) + std::abs(ez[i] - rz[i]),
+                  1e-11 * scale * std::sqrt(double(ns) + 1.0));
+      }
+    }
+}
+
+// the self term (zero distance) is dropped, also between distinct coincident points
+TEST(P2P, ZeroDistanceSkippedAndAccumulates) {
+  double x[2] = {0.0, 0.0}, y[2] = {0.0, 0.0}, z[2] = {0.0, 2.0}, q[2] = {3.0, 5.0};
+  double p[2] = {1.0, 1.0}, ex[2] = {0, 0}, ey[2] = {0, 0}, ez[2] = {0, 0};
+  p2p(2, x, y, z, 2, x, y, z, q, 0, 0, 0, p, ex, ey, ez);
+  // accumulates onto the initial 1.0; particle 0 sees 5/2, particle 1 sees 3/2
+  EXPECT_NEAR(p[0], 1.0 + 2.5, 1e-15);
+  EXPECT_NEAR(p[1], 1.0 + 1.5, 1e-15);
+  EXPECT_NEAR(ez[0], -5.0 / 4.0, 1e-15);  // E = q (r_i - r_j) / r^3 points away from the source
+  EXPECT_NEAR(ez[1], 3.0 / 4.0, 1e-15);
+  EXPECT_EQ(ex[0], 0.0);
+  EXPECT_FALSE(std::isnan(p[0]));
+}
+
+// a target's result must not depend on which other targets are evaluated with it (needed for
+// bit-identical work partitions): evaluate one by one vs all at once, compare exactly
+TEST(P2P, TargetResultIndependentOfBlocking) {
+  auto src = gcfmm_test::random_cube(37, 31);
+  auto tgt = gcfmm_test::random_cube(29, 32);
+  const std::size_t nt = tgt.size();
+  std::vector<double> p(nt, 0), ex(nt, 0), ey(nt, 0), ez(nt, 0);
+  p2p(nt, tgt.x.data(), tgt.y.data(), tgt.z.data(), src.size(), src.x.data(), src.y.data(), src.z.data(),
+      src.q.data(), 0, 0, 0, p.data(), ex.data(), ey.data(), ez.data());
+  for (std::size_t off = 0; off < nt; ++off) {
+    double a = 0, b = 0, c = 0, d = 0;
+    p2p(1, &tgt.x[off], &tgt.y[off], &tgt.z[off], src.size(), src.x.data(), src.y.data(), src.z.data(), src.q.data(),
+        0, 0, 0, &a, &b, &c, &d);
+    EXPECT_EQ(a, p[off]);
+    EXPECT_EQ(b, ex[off]);
+    EXPECT_EQ(c, ey[off]);
+    EXPECT_EQ(d, ez[off]);
+  }
+}
+
+// direct_images = own cell + all shifted copies; with images 0 it is direct_free
+TEST(P2P, DirectImagesMatchesShiftedCopies) {
+  auto s = gcfmm_test::random_cube(60, 41, 5.0);
+  const std::size_t n = s.size();
+  gcfmm_test::Field a(n), b(n), c(n);
+  direct_images(n, s.x.data(), s.y.data(), s.z.data(), s.q.data(), 5.0, 6.0, 0, a.pot.data(), a.ex.data(), a.ey.data(),
+                a.ez.data());
+  direct_free(n, s.x.data(), s.y.data(), s.z.data(), s.q.data(), b.pot.data(), b.ex.data(), b.ey.data(), b.ez.data());
+  for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(a.pot[i], b.pot[i]);
+  direct_images(n, s.x.data(), s.y.data(), s.z.data(), s.q.data(), 5.0, 6.0, 2, a.pot.data(), a.ex.data(), a.ey.data(),
+                a.ez.data());
+  // explicit copies of the sources in the 5 x 5 block
+  gcfmm_test::Particles big;
+  for (int i = -2; i <= 2; ++i)
+    for (int j = -2; j <= 2; ++j)
+      for (std::size_t k = 0; k < n; ++k) {
+        big.x.push_back(s.x[k] + 5.0 * i);
+        big.y.push_back(s.y[k] + 6.0 * j);
+        big.z.push_back(s.z[k]);
+        big.q.push_back(s.q[k]);
+      }
+  std::vector<double> rp(n), rx(n), ry(n), rz(n);
+  ref_sum(s, big, 0, 0, 0, rp, rx, ry, rz);
+  for (std::size_t i = 0; i < n; ++i) {
+    EXPECT_NEAR(a.pot[i], rp[i], 1e-11 * (1 + std::abs(rp[i])));
+    EXPECT_NEAR(a.ez[i], rz[i], 1e-11 * (1 + std::abs(rz[i])));
+  }
+}
