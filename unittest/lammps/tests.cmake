@@ -1,3 +1,4 @@
 # one gc_lammps_test() per test file; see ../CMakeLists.txt
 gc_lammps_test(test_jkr_marshall SOURCES test_jkr_marshall.cpp)
 gc_lammps_test(test_jkr_marshall_reproducible NP 1 2 SOURCES test_jkr_marshall_reproducible.cpp)
+gc_lammps_test(test_coul_fmm NP 1 2 SOURCES test_coul_fmm.cpp)

@@ -1,0 +1,74 @@
+/* -*- c++ -*- ----------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+#ifdef FIX_CLASS
+// clang-format off
+FixStyle(coul/fmm,FixCoulFMM);
+// clang-format on
+#else
+
+#ifndef LMP_FIX_COUL_FMM_H
+#define LMP_FIX_COUL_FMM_H
+
+#include "fix.h"
+
+#include <memory>
+#include <vector>
+
+namespace gcfmm {
+class Solver;
+struct Options;
+}    // namespace gcfmm
+
+namespace LAMMPS_NS {
+
+// Coulomb forces between the charged atoms of a group by the FMM core library (src/fmm):
+// free space (boundary f f f) or periodic in x and y and open in z (boundary p p f).
+class FixCoulFMM : public Fix {
+ public:
+  FixCoulFMM(class LAMMPS *, int, char **);
+  ~FixCoulFMM() override;
+  int setmask() override;
+  void init() override;
+  void setup(int) override;
+  void min_setup(int) override;
+  void post_force(int) override;
+  void min_post_force(int) override;
+  double compute_scalar() override;
+  double memory_usage() override;
+
+  void grow_arrays(int) override;
+  void copy_arrays(int, int, int) override;
+  int pack_exchange(int, double *) override;
+  int unpack_exchange(int, double *) override;
+
+ private:
+  std::unique_ptr<gcfmm::Options> opts;    // solver options from the keywords
+  std::unique_ptr<gcfmm::Solver> solver;
+  int every;                  // recompute every this many steps
+  bigint last_computed;       // step of the last FMM evaluation (-1: none yet)
+  bool bed_given;             // bed zlo/zhi given by the user (farfield average)
+  double energy_local, energy_all;
+  bool energy_summed;
+  double **field;             // per atom: Ex, Ey, Ez, potential (force/charge, energy/charge)
+  bool logged;
+
+  // gathered charged atoms of the group, sorted by atom ID (identical on every rank)
+  std::vector<double> gx, gy, gz, gq, gpot, gex, gey, gez, buf;
+  std::vector<tagint> gtag;
+
+  void compute_field();
+  void apply_field(int vflag);
+  void gather_charges();
+};
+
+}    // namespace LAMMPS_NS
+
+#endif
+#endif

@@ -1,0 +1,283 @@
+/* GRANULAR-CHARGED: fix coul/fmm validated against LAMMPS's own Coulomb solvers (direct
+   coul/cut, ewald + slab) and against sums written here (image block, sheet field).
+   Errors are relative RMS force errors, sqrt(sum |F - F_ref|^2 / sum |F_ref|^2), the quantity
+   `accuracy` requests. */
+#include "gc_testing.h"
+
+#include "exceptions.h"
+#include "library.h"
+#include "gtest/gtest.h"
+
+#include <cmath>
+#include <regex>
+#include <string>
+#include <vector>
+
+using gctest::Lmp;
+
+namespace {
+
+std::vector<double> gather(Lmp &l, const char *name, int cols)
+{
+  const int n = (int) l.var("count(all)");
+  std::vector<double> v((size_t) n * cols);
+  lammps_gather_atoms(l.lmp, (char *) name, 1, cols, v.data());
+  return v;
+}
+
+double rel_rms(const std::vector<double> &f, const std::vector<double> &ref)
+{
+  double num = 0.0, den = 0.0;
+  for (size_t k = 0; k < f.size(); ++k) {
+    num += (f[k] - ref[k]) * (f[k] - ref[k]);
+    den += ref[k] * ref[k];
+  }
+  return std::sqrt(num / den);
+}
+
+// n random charges of both signs (alternating, so the system is neutral for even n) in a box
+void random_charges(Lmp &l, const std::string &boundary, int n, double lx, double lz, int seed)
+{
+  l.cmds({"units real", "atom_style charge", "atom_modify map array sort 0 0",
+          "boundary " + boundary, fmt::format("region box block 0 {} 0 {} 0 {}", lx, lx, lz),
+          "create_box 1 box",
+          fmt::format("create_atoms 1 random {} {} NULL overlap 0.5 maxtry 200", n, seed),
+          "mass 1 1.0", "variable qq atom 2*(id%2)-1", "set group all charge v_qq",
+          "neighbor 1.0 bin", "thermo_style custom step pe", "thermo_modify norm no"});
+}
+
+std::string error_of(const std::vector<std::string> &cmds)
+{
+  Lmp l;
+  try {
+    l.cmds(cmds);
+  } catch (LAMMPS_NS::LAMMPSException &e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+int nprocs()
+{
+  int n;
+  MPI_Comm_size(MPI_COMM_WORLD, &n);
+  return n;
+}
+}    // namespace
+
+// free space vs the exact direct sum (coul/cut beyond the box diagonal), 1000 charges
+TEST(CoulFMM, FreeSpaceVsDirectSum)
+{
+  if (nprocs() > 1) GTEST_SKIP();
+  for (double acc : {1e-3, 1e-4, 1e-6}) {
+    Lmp l;
+    random_charges(l, "f f f", 1000, 40.0, 40.0, 4321);
+    l.cmds({"pair_style coul/cut 100.0", "pair_coeff * *", "run 0 post no"});
+    const auto fref = gather(l, "f", 3);
+    const double eref = l.var("pe");
+    l.cmds({"pair_style zero 1.0", "pair_coeff * *",
+            fmt::format("fix fmm all coul/fmm accuracy {}", acc), "fix_modify fmm energy yes",
+            "run 0 post no"});
+    const auto f = gather(l, "f", 3);
+    const double err = rel_rms(f, fref);
+    std::printf("[ free space ] accuracy %g: force error %.3g, energy error %.3g\n", acc, err,
+                std::fabs(l.var("f_fmm") / eref - 1.0));
+    EXPECT_LT(err, acc);
+    EXPECT_LT(std::fabs(l.var("f_fmm") / eref - 1.0), acc);
+    EXPECT_NEAR(l.var("pe"), l.var("f_fmm"), 1e-12 * std::fabs(eref)) << "fix_modify energy";
+  }
+}
+
+// farfield none, images 1 vs the brute-force sum over the 3 x 3 block written here
+TEST(CoulFMM, ImageBlockVsBruteForce)
+{
+  if (nprocs() > 1) GTEST_SKIP();
+  Lmp l;
+  random_charges(l, "p p f", 400, 20.0, 60.0, 777);
+  l.cmds({"fix fmm all coul/fmm accuracy 1e-6 farfield none images 1", "run 0 post no"});
+  const auto f = gather(l, "f", 3);
+  const auto x = gather(l, "x", 3);
+  const auto q = gather(l, "q", 1);
+  const double c = 332.06371;    // LAMMPS real-units qqr2e
+  const size_t n = q.size();
+  std::vector<double> ref(3 * n, 0.0);
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j < n; ++j)
+      for (int sx = -1; sx <= 1; ++sx)
+        for (int sy = -1; sy <= 1; ++sy) {
+          if (i == j && sx == 0 && sy == 0) continue;
+          const double dx = x[3 * i] - x[3 * j] - sx * 20.0, dy = x[3 * i + 1] - x[3 * j + 1] - sy * 20.0,
+                       dz = x[3 * i + 2] - x[3 * j + 2];
+          const double r2 = dx * dx + dy * dy + dz * dz, s = c * q[i] * q[j] / (r2 * std::sqrt(r2));
+          ref[3 * i] += s * dx;
+          ref[3 * i + 1] += s * dy;
+          ref[3 * i + 2] += s * dz;
+        }
+  const double err = rel_rms(f, ref);
+  std::printf("[ image block ] force error %.3g\n", err);
+  EXPECT_LT(err, 1e-6);
+}
+
+// farfield exact on a neutral system vs ewald + slab at 1e-10 (volfactor 3 and 6 agree)
+TEST(CoulFMM, ExactFarFieldVsEwaldSlab)
+{
+  if (nprocs() > 1) GTEST_SKIP();
+  auto ewald = [](double slab) {
+    Lmp l;
+    random_charges(l, "p p f", 300, 20.0, 40.0, 99);
+    l.cmds({"pair_style coul/long 9.0", "pair_coeff * *", "kspace_style ewald 1e-10",
+            fmt::format("kspace_modify slab {}", slab), "run 0 post no"});
+    return gather(l, "f", 3);
+  };
+  const auto f3 = ewald(3.0), f6 = ewald(6.0);
+  const double conv = rel_rms(f3, f6);
+  std::printf("[ ewald slab ] volfactor 3 vs 6: %.3g\n", conv);
+  EXPECT_LT(conv, 1e-6) << "the slab reference must be converged in its volume factor";
+  for (double acc : {1e-4, 1e-6}) {
+    Lmp l;
+    random_charges(l, "p p f", 300, 20.0, 40.0, 99);
+    l.cmds({fmt::format("fix fmm all coul/fmm accuracy {} farfield exact", acc), "run 0 post no"});
+    const double err = rel_rms(gather(l, "f", 3), f6);
+    std::printf("[ exact far field ] accuracy %g: force error vs ewald+slab %.3g\n", acc, err);
+    // the reference itself is converged to ~1e-7; the allowance is the requested accuracy
+    EXPECT_LT(err, acc + 1e-6);
+  }
+}
+
+// a net-charged layer: far above it the field tends to the sheet field 2 pi sum(q) / A
+// (Gaussian units; times qqr2e in LAMMPS units); the total force on the layer vanishes
+TEST(CoulFMM, NetChargedLayerSheetField)
+{
+  if (nprocs() > 1) GTEST_SKIP();
+  Lmp l;
+  l.cmds({"units real", "atom_style charge", "atom_modify map array", "boundary p p f",
+          "region box block 0 10 0 10 0 200", "create_box 2 box",
+          "region layer block 0 10 0 10 0 2", "create_atoms 1 random 200 5 layer overlap 0.3",
+          "create_atoms 2 single 3.3 7.1 150.0", "mass * 1.0", "set type 1 charge 1.0",
+          "set type 2 charge 1e-3", "fix fmm all coul/fmm accuracy 1e-6 farfield exact",
+          "run 0 post no"});
+  const double sheet = 332.06371 * 2.0 * M_PI * 200.0 / 100.0;
+  const double ez = l.var("fz[201]") / 1e-3;
+  std::printf("[ sheet ] Ez far above / (2 pi sigma) = %.8f\n", ez / sheet);
+  // at 150 A above a 10 A cell the non-uniform part decays like exp(-2 pi z / L): nothing left
+  EXPECT_NEAR(ez / sheet, 1.0, 1e-5);
+  double fz = 0.0, frms = 0.0;
+  for (int i = 1; i <= 200; ++i) {
+    fz += l.var(fmt::format("fz[{}]", i));
+    frms += std::pow(l.var(fmt::format("fz[{}]", i)), 2);
+  }
+  // a periodic layer exerts no net force on itself; sum of 200 forces with relative errors
+  // ~1e-6 each
+  EXPECT_LT(std::fabs(fz), 1e-5 * std::sqrt(frms * 200.0));
+}
+
+// translating all atoms by any horizontal vector (incl. a lattice vector) changes nothing
+TEST(CoulFMM, TranslationInvariance)
+{
+  if (nprocs() > 1) GTEST_SKIP();
+  std::vector<double> base;
+  for (double shift : {0.0, 20.0, 7.3}) {
+    Lmp l;
+    random_charges(l, "p p f", 300, 20.0, 40.0, 123);
+    if (shift != 0.0) l.cmd(fmt::format("displace_atoms all move {} {} 0 units box", shift, 0.5 * shift));
+    l.cmds({"fix fmm all coul/fmm accuracy 1e-6", "run 0 post no"});
+    const auto f = gather(l, "f", 3);
+    if (base.empty()) base = f;
+    const double d = rel_rms(f, base);
+    std::printf("[ invariance ] shift %g: relative change %.3g\n", shift, d);
+    // a lattice shift moves particles by exactly L (x + L - L round-off only); a general shift
+    // changes the tree, so the FMM's own error (< 1e-6) is the bound
+    EXPECT_LT(d, shift == 20.0 ? 1e-10 : 2e-6);
+  }
+}
+
+TEST(CoulFMM, FarFieldAverageRunsAndDiffersFromExact)
+{
+  if (nprocs() > 1) GTEST_SKIP();
+  std::vector<double> fe, fa;
+  for (const char *ff : {"exact", "average"}) {
+    Lmp l;
+    random_charges(l, "p p f", 300, 20.0, 40.0, 55);
+    l.cmds({"set group all charge 1.0", fmt::format("fix fmm all coul/fmm farfield {}", ff),
+            "run 0 post no"});
+    (std::string(ff) == "exact" ? fe : fa) = gather(l, "f", 3);
+  }
+  const double d = rel_rms(fa, fe);
+  std::printf("[ average vs exact ] relative RMS force difference %.3g\n", d);
+  EXPECT_GT(d, 0.0);
+  EXPECT_LT(d, 0.5);
+}
+
+TEST(CoulFMM, NoChargesAndCoincidentAtoms)
+{
+  if (nprocs() > 1) GTEST_SKIP();
+  {
+    Lmp l;
+    random_charges(l, "p p f", 50, 20.0, 40.0, 1);
+    l.cmds({"set group all charge 0.0", "fix fmm all coul/fmm", "run 0 post no"});
+    for (double v : gather(l, "f", 3)) EXPECT_EQ(v, 0.0);
+    EXPECT_EQ(l.var("f_fmm"), 0.0);
+  }
+  const std::string msg = error_of({"units real", "atom_style charge", "boundary f f f",
+                                    "region box block 0 10 0 10 0 10", "create_box 1 box",
+                                    "create_atoms 1 single 1 1 1", "create_atoms 1 single 1 1 1",
+                                    "mass 1 1", "set group all charge 1.0", "fix fmm all coul/fmm",
+                                    "run 0 post no"});
+  EXPECT_TRUE(std::regex_search(msg, std::regex("coul/fmm.*FMM library"))) << msg;
+}
+
+TEST(CoulFMM, BadInput)
+{
+  if (nprocs() > 1) GTEST_SKIP();
+  auto run_with = [](const std::string &atom_style, const std::string &boundary,
+                     const std::string &fix, const std::string &extra = "") {
+    std::vector<std::string> c = {"units real", "atom_style " + atom_style};
+    if (!extra.empty()) c.push_back(extra);
+    c.insert(c.end(), {"boundary " + boundary, "region box block 0 10 0 10 0 10", "create_box 1 box",
+                       "create_atoms 1 single 1 1 1", "mass 1 1", fix, "run 0 post no"});
+    return error_of(c);
+  };
+  auto expect_match = [](const std::string &msg, const std::string &re) {
+    EXPECT_TRUE(std::regex_search(msg, std::regex(re))) << "message: " << msg << "\nexpected: " << re;
+  };
+  expect_match(run_with("atomic", "p p f", "fix fmm all coul/fmm"), "requires an atom style with charge");
+  expect_match(run_with("charge", "p p p", "fix fmm all coul/fmm"), "boundary f f f .* or p p f.*got periodicity p p p");
+  expect_match(run_with("charge", "p f p", "fix fmm all coul/fmm"), "got periodicity p f p");
+  expect_match(error_of({"units real", "atom_style charge", "boundary p p f",
+                         "region box prism 0 10 0 10 0 10 1 0 0", "create_box 1 box", "mass 1 1",
+                         "fix fmm all coul/fmm", "run 0 post no"}),
+               "does not support triclinic");
+  expect_match(error_of({"units lj", "dimension 2", "atom_style charge", "boundary p p p",
+                         "region box block 0 10 0 10 -0.5 0.5", "create_box 1 box", "mass 1 1",
+                         "fix fmm all coul/fmm", "run 0 post no"}),
+               "requires a 3d simulation");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm bogus 1"), "Unknown fix coul/fmm keyword: bogus");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm accuracy 0"), "accuracy must be in \\(0, 1\\), got 0");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm accuracy 1"), "accuracy must be in \\(0, 1\\), got 1");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm order 0"), "order must be in \\[1, .*\\], got 0");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm leaf 0"), "leaf must be >= 1, got 0");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm images -1"), "images must be >= 0, got -1");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm farfield maybe"), "farfield must be exact, average or none, got maybe");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm every 0"), "every must be >= 1, got 0");
+}
+
+// 1 and 2 ranks agree to 1e-12 (every target is computed by one rank, in the same order)
+TEST(CoulFMM, OneVersusTwoRanks)
+{
+  if (nprocs() != 2) GTEST_SKIP() << "needs mpirun -np 2";
+  auto forces = [](MPI_Comm comm) {
+    Lmp l(comm);
+    random_charges(l, "p p f", 500, 20.0, 60.0, 31);
+    l.cmds({"fix fmm all coul/fmm accuracy 1e-5", "run 0 post no"});
+    auto f = gather(l, "f", 3);
+    f.push_back(l.var("f_fmm"));
+    return f;
+  };
+  const auto two = forces(MPI_COMM_WORLD);
+  int me;
+  MPI_Comm_rank(MPI_COMM_WORLD, &me);
+  std::vector<double> one(two.size());
+  if (me == 0) one = forces(MPI_COMM_SELF);
+  MPI_Bcast(one.data(), (int) one.size(), MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  EXPECT_LT(rel_rms(two, one), 1e-12);
+}
