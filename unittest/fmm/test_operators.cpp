@@ -158,3 +158,58 @@ TEST(Operators, L2LExactForPolynomial) {
   EXPECT_LT(std::abs(p1 - p2), 1e-12 * (1.0 + std::abs(p1)));
   EXPECT_LT(std::abs(x1 - x2) + std::abs(y1 - y2) + std::abs(z1 - z2), 1e-11 * (1.0 + std::abs(x1) + std::abs(z1)));
 }
+
+// The batched (SIMD-lane) P2M, M2L and L2P used by the solver agree with the single operators
+// to round-off (1e-13 relative: only the summation order differs), and a point's L2P result
+// does not depend on the batch it is evaluated in (bit-identical).
+TEST(Operators, BatchedMatchSingle) {
+  auto src = gcfmm_test::random_cube(29, 5);
+  for (int p : {3, 8, 13, 17}) {  // 17: beyond the register-blocked rows (generic path)
+    Operators ops(p);
+    const std::size_t es = ops.size();
+    std::vector<double> M1(es, 0.0), M2(es, 0.0);
+    const Vec3 c{0.45, 0.5, 0.55};
+    ops.p2m(src.size(), src.x.data(), src.y.data(), src.z.data(), src.q.data(), c, M1.data());
+    ops.p2m_batch(src.size(), src.x.data(), src.y.data(), src.z.data(), src.q.data(), c, M2.data());
+    ops.symmetrize(M1.data());
+    ops.symmetrize(M2.data());
+    double d = 0, s = 0;
+    for (std::size_t i = 0; i < es; ++i) {
+      d = std::max(d, std::abs(M1[i] - M2[i]));
+      s = std::max(s, std::abs(M1[i]));
+    }
+    EXPECT_LT(d, 1e-13 * s) << "p2m p=" << p;
+    // 11 M2L into one local expansion: batched vs one by one
+    std::vector<const double *> ms(11, M1.data());
+    std::vector<Vec3> rs(11);
+    for (int e = 0; e < 11; ++e) rs[e] = {3.0 + 0.1 * e, -2.0 + 0.3 * e, 2.5 - 0.2 * e};
+    std::vector<double> L1(es, 0.0), L2(es, 0.0);
+    for (int e = 0; e < 11; ++e) ops.m2l(M1.data(), rs[e], L1.data());
+    ops.m2l_batch(11, ms.data(), rs.data(), L2.data());
+    ops.symmetrize(L1.data());
+    ops.symmetrize(L2.data());
+    d = s = 0;
+    for (std::size_t i = 0; i < es; ++i) {
+      d = std::max(d, std::abs(L1[i] - L2[i]));
+      s = std::max(s, std::abs(L1[i]));
+    }
+    EXPECT_LT(d, 1e-13 * s) << "m2l p=" << p;
+    // L2P at 13 points
+    auto pts = gcfmm_test::random_cube(13, 6, 0.4);
+    std::vector<double> pb(13, 0), xb(13, 0), yb(13, 0), zb(13, 0);
+    ops.l2p_batch(L1.data(), Vec3{0.2, 0.2, 0.2}, 13, pts.x.data(), pts.y.data(), pts.z.data(), pb.data(), xb.data(),
+                  yb.data(), zb.data());
+    for (int i = 0; i < 13; ++i) {
+      double ps = 0, xs = 0, ys = 0, zs = 0;
+      ops.l2p(L1.data(), Vec3{pts.x[i] - 0.2, pts.y[i] - 0.2, pts.z[i] - 0.2}, ps, xs, ys, zs);
+      const double sc = std::abs(ps) + std::abs(xs) + std::abs(ys) + std::abs(zs);
+      EXPECT_LT(std::abs(ps - pb[i]) + std::abs(xs - xb[i]) + std::abs(ys - yb[i]) + std::abs(zs - zb[i]), 1e-13 * sc);
+      // the same point alone in its batch: bit-identical
+      double p1 = 0, x1 = 0, y1 = 0, z1 = 0;
+      ops.l2p_batch(L1.data(), Vec3{0.2, 0.2, 0.2}, 1, &pts.x[i], &pts.y[i], &pts.z[i], &p1, &x1, &y1, &z1);
+      EXPECT_EQ(p1, pb[i]);
+      EXPECT_EQ(x1, xb[i]);
+      EXPECT_EQ(z1, zb[i]);
+    }
+  }
+}

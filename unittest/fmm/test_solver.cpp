@@ -420,25 +420,3 @@ TEST(Solver, OptionsValidation) {
   per.build(1, &a, &a, &a);
   EXPECT_THROW(per.evaluate(&q, x.pot.data(), x.ex.data(), x.ey.data(), x.ez.data(), 2, 2), std::invalid_argument);
 }
-
-#if __has_include("gcfmm/lattice_sum.hpp")
-// Smoke test of the hook into the far field (its accuracy is tested in test_lattice_sum):
-// the exact far field changes the near-field result and keeps the total force ~ 0.
-TEST(Solver, ExactFarFieldHook) {
-  auto p = gcfmm_test::deposition(1000, 113);
-  Options o = periodic_opts(1e-4, 1);
-  o.farfield = FarField::Exact;
-  Stats st;
-  Field f = periodic_fmm(p, o, 28.0, &st);
-  Field n = periodic_fmm(p, periodic_opts(1e-4, 1), 28.0);
-  double d = 0, sz = 0, sabs = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    d = std::max(d, std::abs(f.ez[i] - n.ez[i]));
-    sz += p.q[i] * f.ez[i];
-    sabs += std::abs(p.q[i] * f.ez[i]);
-    EXPECT_TRUE(std::isfinite(f.ez[i]));
-  }
-  EXPECT_GT(d, 0.0);
-  EXPECT_LT(std::abs(sz), 1e-3 * sabs);
-}
-#endif

@@ -142,6 +142,189 @@ void Operators::p2m(std::size_t np, const double *x, const double *y, const doub
   }
 }
 
+namespace {
+
+constexpr int kMaxFixedOrder = 16;
+constexpr int kLanes = Operators::kBatch;
+
+// One row n of the batched M2L sum with n known at compile time: the n+1 outputs (m = 0..n)
+// of all lanes stay in registers while (k, l) run over the sources.
+template <int N>
+inline void m2l_row(int p, const double *__restrict Mr, const double *__restrict Mi, const double *__restrict Tr,
+                    const double *__restrict Ti, double *__restrict Ar, double *__restrict Ai) {
+  constexpr int W = kLanes;
+  double accr[N + 1][W], acci[N + 1][W];
+  for (int m = 0; m <= N; ++m)
+    for (int v = 0; v < W; ++v) {
+      accr[m][v] = Ar[idx(N, m) * W + v];
+      acci[m][v] = Ai[idx(N, m) * W + v];
+    }
+  for (int k = 0; k <= p - N; ++k)
+    for (int l = -k; l <= k; ++l) {
+      const double *__restrict mr = Mr + idx(k, l) * W, *__restrict mi = Mi + idx(k, l) * W;
+      const double *__restrict tr = Tr + idx(N + k, l) * W, *__restrict ti = Ti + idx(N + k, l) * W;
+      for (int m = 0; m <= N; ++m)
+#pragma omp simd
+        for (int v = 0; v < W; ++v) {
+          accr[m][v] += mr[v] * tr[m * W + v] - mi[v] * ti[m * W + v];
+          acci[m][v] += mr[v] * ti[m * W + v] + mi[v] * tr[m * W + v];
+        }
+    }
+  for (int m = 0; m <= N; ++m)
+    for (int v = 0; v < W; ++v) {
+      Ar[idx(N, m) * W + v] = accr[m][v];
+      Ai[idx(N, m) * W + v] = acci[m][v];
+    }
+}
+
+template <int N>
+inline void m2l_rows_from(int p, const double *Mr, const double *Mi, const double *Tr, const double *Ti, double *Ar,
+                          double *Ai) {
+  if (N > p) return;
+  m2l_row<N>(p, Mr, Mi, Tr, Ti, Ar, Ai);
+  if constexpr (N < kMaxFixedOrder) m2l_rows_from<N + 1>(p, Mr, Mi, Tr, Ti, Ar, Ai);
+}
+
+inline void m2l_rows(int p, const double *Mr, const double *Mi, const double *Tr, const double *Ti, double *Ar,
+                     double *Ai) {
+  m2l_rows_from<0>(p, Mr, Mi, Tr, Ti, Ar, Ai);
+}
+
+}  // namespace
+
+namespace {
+// regular harmonics (m >= 0 only) of kLanes points at once, lane-major layout [idx][lane]
+inline void regular_lanes(int p, const double *inv_nm, const double *x, const double *y, const double *z,
+                          double *__restrict Yr, double *__restrict Yi) {
+  constexpr int W = kLanes;
+  double r2[W];
+  for (int v = 0; v < W; ++v) {
+    r2[v] = x[v] * x[v] + y[v] * y[v] + z[v] * z[v];
+    Yr[v] = 1.0;
+    Yi[v] = 0.0;
+  }
+  for (int n = 1; n <= p; ++n) {
+    const double h = -1.0 / (2.0 * n), f = 2.0 * n - 1.0;
+    const int dn = idx(n, n) * W, dp = idx(n - 1, n - 1) * W;
+    for (int v = 0; v < W; ++v) {
+      const double c = h * x[v], d = h * y[v], a = Yr[dp + v], b = Yi[dp + v];
+      Yr[dn + v] = c * a - d * b;
+      Yi[dn + v] = c * b + d * a;
+    }
+    for (int m = 0; m < n; ++m) {
+      const double s = inv_nm[n * (p + 1) + m];
+      const int i0 = idx(n, m) * W, i1 = idx(n - 1, m) * W;
+      if (m <= n - 2) {
+        const int i2 = idx(n - 2, m) * W;
+        for (int v = 0; v < W; ++v) {
+          Yr[i0 + v] = (f * z[v] * Yr[i1 + v] - r2[v] * Yr[i2 + v]) * s;
+          Yi[i0 + v] = (f * z[v] * Yi[i1 + v] - r2[v] * Yi[i2 + v]) * s;
+        }
+      } else {
+        for (int v = 0; v < W; ++v) {
+          Yr[i0 + v] = f * z[v] * Yr[i1 + v] * s;
+          Yi[i0 + v] = f * z[v] * Yi[i1 + v] * s;
+        }
+      }
+    }
+  }
+}
+}  // namespace
+
+void Operators::p2m_batch(std::size_t np, const double *x, const double *y, const double *z, const double *q,
+                          const Vec3 &c, double *M) const {
+  constexpr int W = kBatch;
+  const int p = p_, S = S_;
+  double *Yr = bt_.data(), *Yi = bt_.data() + S * W;
+  double *__restrict Ar = ba_.data(), *__restrict Ai = ba_.data() + S * W;
+  std::fill(ba_.begin(), ba_.end(), 0.0);
+  for (std::size_t j0 = 0; j0 < np; j0 += W) {
+    const int nl = static_cast<int>(std::min<std::size_t>(W, np - j0));
+    double dx[W], dy[W], dz[W], qq[W];
+    for (int v = 0; v < W; ++v) {
+      const bool in = v < nl;
+      dx[v] = in ? x[j0 + v] - c.x : 0.0;
+      dy[v] = in ? y[j0 + v] - c.y : 0.0;
+      dz[v] = in ? z[j0 + v] - c.z : 0.0;
+      qq[v] = in ? q[j0 + v] : 0.0;
+    }
+    regular_lanes(p, inv_nm_.data(), dx, dy, dz, Yr, Yi);
+    for (int n = 0; n <= p; ++n)
+      for (int m = 0; m <= n; ++m) {
+        const int i = idx(n, m) * W;
+#pragma omp simd
+        for (int v = 0; v < W; ++v) {
+          Ar[i + v] += qq[v] * Yr[i + v];
+          Ai[i + v] -= qq[v] * Yi[i + v];
+        }
+      }
+  }
+  for (int n = 0; n <= p; ++n)
+    for (int m = 0; m <= n; ++m) {
+      double sr = 0.0, si = 0.0;
+      for (int v = 0; v < W; ++v) {
+        sr += Ar[idx(n, m) * W + v];
+        si += Ai[idx(n, m) * W + v];
+      }
+      M[idx(n, m)] += sr;
+      M[S + idx(n, m)] += si;
+    }
+}
+
+void Operators::l2p_batch(const double *L, const Vec3 &c, std::size_t np, const double *x, const double *y,
+                          const double *z, double *pot, double *ex, double *ey, double *ez) const {
+  constexpr int W = kBatch;
+  const int p = p_, S = S_;
+  double *Yr = bt_.data(), *Yi = bt_.data() + S * W;
+  const double *lr = L, *li = L + S;
+  for (std::size_t j0 = 0; j0 < np; j0 += W) {
+    const int nl = static_cast<int>(std::min<std::size_t>(W, np - j0));
+    double dx[W], dy[W], dz[W];
+    for (int v = 0; v < W; ++v) {
+      const bool in = v < nl;
+      dx[v] = in ? x[j0 + v] - c.x : 0.0;
+      dy[v] = in ? y[j0 + v] - c.y : 0.0;
+      dz[v] = in ? z[j0 + v] - c.z : 0.0;
+    }
+    regular_lanes(p, inv_nm_.data(), dx, dy, dz, Yr, Yi);
+    double ph[W], a0[W], a1r[W], a1i[W];
+    for (int v = 0; v < W; ++v) ph[v] = a0[v] = a1r[v] = a1i[v] = 0.0;
+    // potential: sum_{n,m} L_n^m conj(Y_n^m) = sum_n [L_n^0 Y_n^0 + 2 sum_{m>0} Re(L_n^m conj(Y_n^m))]
+    for (int n = 0; n <= p; ++n)
+      for (int m = 0; m <= n; ++m) {
+        const double w = m == 0 ? 1.0 : 2.0;
+        const double Lr = w * lr[idx(n, m)], Li = w * li[idx(n, m)];
+        const int i = idx(n, m) * W;
+#pragma omp simd
+        for (int v = 0; v < W; ++v) ph[v] += Lr * Yr[i + v] + Li * Yi[i + v];
+      }
+    // degree-1 coefficients re-centred at the point: L'_1^m = sum_{k<=p-1,l} L_{1+k}^{m+l} conj(Y_k^l)
+    // for m = 0, 1; negative l from Y_k^{-l} = (-1)^l conj(Y_k^l)
+    for (int k = 0; k <= p - 1; ++k)
+      for (int l = -k; l <= k; ++l) {
+        const int al = l < 0 ? -l : l;
+        const double sg = (l < 0 && (al & 1)) ? -1.0 : 1.0;
+        const int i = idx(k, al) * W;
+        const double sr = sg, si = l < 0 ? -sg : sg;  // Y_k^l = (sr Re, si Im) of Y_k^|l|
+        const double A0r = lr[idx(1 + k, l)], A0i = li[idx(1 + k, l)];
+        const double A1r = lr[idx(1 + k, 1 + l)], A1i = li[idx(1 + k, 1 + l)];
+#pragma omp simd
+        for (int v = 0; v < W; ++v) {
+          const double yr = sr * Yr[i + v], yi = si * Yi[i + v];
+          a0[v] += A0r * yr + A0i * yi;
+          a1r[v] += A1r * yr + A1i * yi;
+          a1i[v] += A1i * yr - A1r * yi;
+        }
+      }
+    for (int v = 0; v < nl; ++v) {
+      pot[j0 + v] += ph[v];
+      ex[j0 + v] += a1r[v];
+      ey[j0 + v] += a1i[v];
+      ez[j0 + v] -= a0[v];
+    }
+  }
+}
+
 void Operators::m2m(const double *Mc, const Vec3 &d, double *Mp) const {
   double *yr = wr_.data(), *yi = wi_.data();
   regular(d, p_, yr, yi);
@@ -251,55 +434,6 @@ void Operators::m2l(const double *Ms, const Vec3 &R, double *Lt) const {
   }
 }
 
-namespace {
-
-constexpr int kMaxFixedOrder = 16;
-constexpr int kLanes = Operators::kBatch;
-
-// One row n of the batched M2L sum with n known at compile time: the n+1 outputs (m = 0..n)
-// of all lanes stay in registers while (k, l) run over the sources.
-template <int N>
-inline void m2l_row(int p, const double *__restrict Mr, const double *__restrict Mi, const double *__restrict Tr,
-                    const double *__restrict Ti, double *__restrict Ar, double *__restrict Ai) {
-  constexpr int W = kLanes;
-  double accr[N + 1][W], acci[N + 1][W];
-  for (int m = 0; m <= N; ++m)
-    for (int v = 0; v < W; ++v) {
-      accr[m][v] = Ar[idx(N, m) * W + v];
-      acci[m][v] = Ai[idx(N, m) * W + v];
-    }
-  for (int k = 0; k <= p - N; ++k)
-    for (int l = -k; l <= k; ++l) {
-      const double *__restrict mr = Mr + idx(k, l) * W, *__restrict mi = Mi + idx(k, l) * W;
-      const double *__restrict tr = Tr + idx(N + k, l) * W, *__restrict ti = Ti + idx(N + k, l) * W;
-      for (int m = 0; m <= N; ++m)
-#pragma omp simd
-        for (int v = 0; v < W; ++v) {
-          accr[m][v] += mr[v] * tr[m * W + v] - mi[v] * ti[m * W + v];
-          acci[m][v] += mr[v] * ti[m * W + v] + mi[v] * tr[m * W + v];
-        }
-    }
-  for (int m = 0; m <= N; ++m)
-    for (int v = 0; v < W; ++v) {
-      Ar[idx(N, m) * W + v] = accr[m][v];
-      Ai[idx(N, m) * W + v] = acci[m][v];
-    }
-}
-
-template <int N>
-inline void m2l_rows_from(int p, const double *Mr, const double *Mi, const double *Tr, const double *Ti, double *Ar,
-                          double *Ai) {
-  if (N > p) return;
-  m2l_row<N>(p, Mr, Mi, Tr, Ti, Ar, Ai);
-  if constexpr (N < kMaxFixedOrder) m2l_rows_from<N + 1>(p, Mr, Mi, Tr, Ti, Ar, Ai);
-}
-
-inline void m2l_rows(int p, const double *Mr, const double *Mi, const double *Tr, const double *Ti, double *Ar,
-                     double *Ai) {
-  m2l_rows_from<0>(p, Mr, Mi, Tr, Ti, Ar, Ai);
-}
-
-}  // namespace
 
 void Operators::m2l_batch(std::size_t count, const double *const *Ms, const Vec3 *R, double *Lt) const {
   constexpr int W = kBatch;

@@ -284,8 +284,8 @@ void Solver::evaluate(const double *q, double *pot, double *ex, double *ey, doub
     const Node &A = nodes[i];
     double *Mi = I.M.data() + i * es;
     if (A.leaf())
-      ops.p2m(A.count(), xs.data() + A.begin, ys.data() + A.begin, zs.data() + A.begin, I.qs.data() + A.begin,
-              A.center, Mi);
+      ops.p2m_batch(A.count(), xs.data() + A.begin, ys.data() + A.begin, zs.data() + A.begin,
+                    I.qs.data() + A.begin, A.center, Mi);
     ops.symmetrize(Mi);
     if (A.parent >= 0) {
       const Node &P = nodes[A.parent];
@@ -352,9 +352,8 @@ void Solver::evaluate(const double *q, double *pot, double *ex, double *ey, doub
     ops.symmetrize(Li);
     if (A.leaf()) {
       const std::size_t a = std::max<std::size_t>(A.begin, tb), b = std::min<std::size_t>(A.end, te);
-      for (std::size_t k = a; k < b; ++k)
-        ops.l2p(Li, Vec3{xs[k] - A.center.x, ys[k] - A.center.y, zs[k] - A.center.z}, I.ps[k], I.exs[k], I.eys[k],
-                I.ezs[k]);
+      ops.l2p_batch(Li, A.center, b - a, xs.data() + a, ys.data() + a, zs.data() + a, I.ps.data() + a,
+                    I.exs.data() + a, I.eys.data() + a, I.ezs.data() + a);
     }
   }
   t1 = Clock::now();

@@ -50,6 +50,10 @@ class Operators {
   /** P2M: M_n^m += sum_j q_j conj(Y_n^m(y_j - c)), m >= 0 only. */
   void p2m(std::size_t n, const double *x, const double *y, const double *z, const double *q,
            const Vec3 &c, double *M) const;
+  /** Batched P2M over n particles, kBatch particles per SIMD lane (lane sums added at the end
+   *  in a fixed order): same expansion as p2m() up to round-off; m >= 0 only. */
+  void p2m_batch(std::size_t n, const double *x, const double *y, const double *z, const double *q, const Vec3 &c,
+                 double *M) const;
   /** M2M: M_parent += shift of the (full) child multipole M_child; d = z_child - z_parent.
    *  M'_n^m = sum_{k<=n,l} conj(Y_k^l(d)) M_{n-k}^{m-l}; m >= 0 only. Exact (no truncation). */
   void m2m(const double *Mchild, const Vec3 &d, double *Mparent) const;
@@ -70,6 +74,11 @@ class Operators {
   void l2l(const double *Lparent, const Vec3 &b, double *Lchild) const;
   /** L2P: potential and field E = -grad phi of the (full) local expansion at r = x - z_t, added. */
   void l2p(const double *L, const Vec3 &r, double &pot, double &ex, double &ey, double &ez) const;
+  /** Batched L2P: adds the potential and field of the (full) local expansion about c at the n
+   *  points (x, y, z)[0..n), kBatch points per SIMD lane. Lanes never mix, so each point's
+   *  result depends only on its own position (not on n or its place in the batch). */
+  void l2p_batch(const double *L, const Vec3 &c, std::size_t n, const double *x, const double *y, const double *z,
+                 double *pot, double *ex, double *ey, double *ez) const;
   /** M2P (for tests): potential of the (full) multipole at r = x - z_s. */
   double m2p_potential(const double *M, const Vec3 &r) const;
 
