@@ -420,3 +420,59 @@ TEST(Solver, OptionsValidation) {
   per.build(1, &a, &a, &a);
   EXPECT_THROW(per.evaluate(&q, x.pot.data(), x.ex.data(), x.ey.data(), x.ez.data(), 2, 2), std::invalid_argument);
 }
+
+// A rectangular cell (lx != ly) with images 1 and 2 against direct_images.
+TEST(Solver, RectangularCell) {
+  const double lx = 28.0, ly = 19.0;
+  auto p = gcfmm_test::deposition(1500, 115, lx, ly);
+  for (int images : {1, 2}) {
+    Field ref(p.size());
+    direct_images(p.size(), p.x.data(), p.y.data(), p.z.data(), p.q.data(), lx, ly, images, ref.pot.data(),
+                  ref.ex.data(), ref.ey.data(), ref.ez.data());
+    Solver s(periodic_opts(1e-4, images));
+    s.set_box(0.0, 0.0, lx, ly);
+    s.build(p.size(), p.x.data(), p.y.data(), p.z.data());
+    Field f = run(s, p);
+    EXPECT_LT(gcfmm_test::force_error(p.q, f, ref), 1e-4) << "images " << images;
+  }
+}
+
+// Physical units (LAMMPS si: micron particles, femtocoulomb charges): scaling positions by
+// 1e-6 and charges by 1e-15 scales E by 1e-15 / 1e-12 and leaves the relative error unchanged.
+TEST(Solver, SmallLengthScales) {
+  auto p = gcfmm_test::deposition(1200, 116);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    p.x[i] *= 1e-6;
+    p.y[i] *= 1e-6;
+    p.z[i] *= 1e-6;
+    p.q[i] *= 1e-15;
+  }
+  Field ref(p.size());
+  direct_images(p.size(), p.x.data(), p.y.data(), p.z.data(), p.q.data(), 28e-6, 28e-6, 1, ref.pot.data(),
+                ref.ex.data(), ref.ey.data(), ref.ez.data());
+  Solver s(periodic_opts(1e-4, 1));
+  s.set_box(0.0, 0.0, 28e-6, 28e-6);
+  s.build(p.size(), p.x.data(), p.y.data(), p.z.data());
+  Field f = run(s, p);
+  EXPECT_LT(gcfmm_test::force_error(p.q, f, ref), 1e-4);
+}
+
+// More parts than leaves: empty parts are legal and give zeros; the sum is still exact.
+TEST(Solver, MorePartsThanLeaves) {
+  auto p = gcfmm_test::random_cube(5, 117);
+  Solver s(Options{});
+  s.build(p.size(), p.x.data(), p.y.data(), p.z.data());
+  Field all = run(s, p);
+  Field sum(p.size());
+  for (int part = 0; part < 4; ++part) {
+    Field f = run(s, p, part, 4);
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      sum.pot[i] += f.pot[i];
+      sum.ex[i] += f.ex[i];
+    }
+  }
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    EXPECT_EQ(sum.pot[i], all.pot[i]);
+    EXPECT_EQ(sum.ex[i], all.ex[i]);
+  }
+}
