@@ -1,7 +1,6 @@
 // GRANULAR-CHARGED FMM core library (gcfmm): dual-tree traversal.
 #include "gcfmm/interaction_lists.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -53,15 +52,17 @@ void build_lists(const Tree &tree, const std::vector<Vec3> &shifts, double theta
       }
     }
   }
-  auto by_target = [](const Interaction &u, const Interaction &v) { return u.target < v.target; };
-  std::stable_sort(L.m2l.begin(), L.m2l.end(), by_target);
-  std::stable_sort(L.p2p.begin(), L.p2p.end(), by_target);
-  for (const auto &e : L.m2l) ++L.m2l_offset[e.target + 1];
-  for (const auto &e : L.p2p) ++L.p2p_offset[e.target + 1];
-  for (std::size_t i = 0; i < nn; ++i) {
-    L.m2l_offset[i + 1] += L.m2l_offset[i];
-    L.p2p_offset[i + 1] += L.p2p_offset[i];
-  }
+  // stable counting sort by target node (keeps the traversal order within a target)
+  auto sort_by_target = [nn](std::vector<Interaction> &v, std::vector<std::uint32_t> &off) {
+    for (const auto &e : v) ++off[e.target + 1];
+    for (std::size_t i = 0; i < nn; ++i) off[i + 1] += off[i];
+    std::vector<Interaction> out(v.size());
+    std::vector<std::uint32_t> pos(off.begin(), off.end() - 1);
+    for (const auto &e : v) out[pos[e.target]++] = e;
+    v.swap(out);
+  };
+  sort_by_target(L.m2l, L.m2l_offset);
+  sort_by_target(L.p2p, L.p2p_offset);
 }
 
 }  // namespace gcfmm
