@@ -1,0 +1,226 @@
+"""Packing analysis from LAMMPS dumps: volume fraction of a slab (exact sphere-slab volumes),
+geometric contacts and coordination numbers, f(Z), g(r) of a slab, phi(z) profile, bed surface.
+
+The box is periodic in x and y and open in z (the decks' ``boundary p p f``). These functions
+are the Python reference for the package's computes ``packing/slab``, ``coord/dist`` and
+``rdf/slab``; python/tests cross-checks them against the computes when those are built.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+
+@dataclass
+class Snapshot:
+    step: int
+    box: np.ndarray          # [[xlo, xhi], [ylo, yhi], [zlo, zhi]]
+    cols: dict               # column name -> np.ndarray, sorted by id when 'id' exists
+
+    def __getitem__(self, k):
+        return self.cols[k]
+
+    @property
+    def n(self) -> int:
+        return len(next(iter(self.cols.values()))) if self.cols else 0
+
+    @property
+    def xyz(self) -> np.ndarray:
+        return np.column_stack([self.cols["x"], self.cols["y"], self.cols["z"]])
+
+    @property
+    def lx(self) -> float:
+        return float(self.box[0, 1] - self.box[0, 0])
+
+    @property
+    def ly(self) -> float:
+        return float(self.box[1, 1] - self.box[1, 0])
+
+
+def read_dump(path, last_only=False):
+    """Read a LAMMPS text dump (custom or local). Returns a list of Snapshot (or the last)."""
+    snaps = []
+    with open(path) as fh:
+        lines = fh.read().split("\n")
+    i, n = 0, len(lines)
+    while i < n:
+        if not lines[i].startswith("ITEM: TIMESTEP"):
+            i += 1
+            continue
+        step = int(lines[i + 1])
+        i += 2
+        nrows = None
+        box = np.zeros((3, 2))
+        cols = {}
+        while i < n and lines[i].startswith("ITEM:"):
+            item = lines[i]
+            if item.startswith("ITEM: NUMBER OF"):
+                nrows = int(lines[i + 1])
+                i += 2
+            elif item.startswith("ITEM: BOX BOUNDS"):
+                for d in range(3):
+                    box[d] = [float(v) for v in lines[i + 1 + d].split()[:2]]
+                i += 4
+            elif item.startswith("ITEM: ATOMS") or item.startswith("ITEM: ENTRIES"):
+                names = item.split()[2:]
+                data = np.array([lines[i + 1 + k].split() for k in range(nrows)], dtype=float)
+                data = data.reshape(nrows, len(names))
+                cols = {nm: data[:, c] for c, nm in enumerate(names)}
+                if "id" in cols:
+                    order = np.argsort(cols["id"])
+                    cols = {k: v[order] for k, v in cols.items()}
+                    cols["id"] = cols["id"].astype(int)
+                i += 1 + nrows
+                break
+            else:
+                i += 1
+        snaps.append(Snapshot(step, box, cols))
+    if last_only:
+        return snaps[-1] if snaps else None
+    return snaps
+
+
+# ---- volume fraction ------------------------------------------------------------------------
+
+def sphere_slab_volume(zc, r, zlo, zhi):
+    """Exact volume of spheres (centres zc, radii r) between the planes z = zlo and z = zhi:
+    int_{max(zlo, zc - r)}^{min(zhi, zc + r)} pi (r^2 - (s - zc)^2) ds. Vectorised."""
+    zc = np.asarray(zc, dtype=float)
+    r = np.broadcast_to(np.asarray(r, dtype=float), zc.shape)
+    u1 = np.clip(zlo - zc, -r, r)
+    u2 = np.clip(zhi - zc, -r, r)
+    F = lambda u: math.pi * (r * r * u - u ** 3 / 3.0)
+    return np.maximum(F(u2) - F(u1), 0.0)
+
+
+def phi_slab(snap: Snapshot, zlo: float, zhi: float) -> float:
+    """Volume fraction of the bed between zlo and zhi (periodic x, y)."""
+    v = sphere_slab_volume(snap["z"], snap["radius"], zlo, zhi).sum()
+    return float(v / (snap.lx * snap.ly * (zhi - zlo)))
+
+
+def phi_profile(snap: Snapshot, dz: float, zmax: float | None = None):
+    """phi(z) in bins of width dz from z = 0: returns (bin centres, phi)."""
+    zmax = zmax if zmax is not None else float(np.max(snap["z"] + snap["radius"]))
+    edges = np.arange(0.0, zmax + dz, dz)
+    phi = np.array([phi_slab(snap, a, b) for a, b in zip(edges[:-1], edges[1:])])
+    return 0.5 * (edges[:-1] + edges[1:]), phi
+
+
+def analysis_slab(snap: Snapshot, rp: float, zlo_rp: float = 4.0, top_rp: float = 6.0):
+    """The decks' analysis region: zlo = zlo_rp r_p (excludes the floor layer),
+    zhi = 2 <z> - top_rp r_p (2 <z> is the height of a uniform bed with the same centroid;
+    top_rp r_p below it excludes the rough top). Same rule as in.deposition."""
+    zlo = zlo_rp * rp
+    zhi = 2.0 * float(np.mean(snap["z"])) - top_rp * rp
+    return zlo, zhi
+
+
+def surface_heights(snap: Snapshot, cell: float):
+    """Highest sphere top (z + r) in each column of a cell x cell grid (nan where empty)."""
+    nx = max(1, int(round(snap.lx / cell)))
+    ny = max(1, int(round(snap.ly / cell)))
+    ix = np.floor((snap["x"] - snap.box[0, 0]) / snap.lx * nx).astype(int) % nx
+    iy = np.floor((snap["y"] - snap.box[1, 0]) / snap.ly * ny).astype(int) % ny
+    top = np.full((nx, ny), np.nan)
+    for a, b, t in zip(ix, iy, snap["z"] + snap["radius"]):
+        if not (t <= top[a, b]):
+            top[a, b] = t
+    return top
+
+
+# ---- contacts -------------------------------------------------------------------------------
+
+def _tree(snap: Snapshot):
+    xyz = snap.xyz.copy()
+    xyz[:, 0] = np.mod(xyz[:, 0] - snap.box[0, 0], snap.lx)
+    xyz[:, 1] = np.mod(xyz[:, 1] - snap.box[1, 0], snap.ly)
+    zmin = xyz[:, 2].min()
+    xyz[:, 2] -= zmin
+    bz = 4.0 * (xyz[:, 2].max() + 1.0) + 10.0 * snap.lx     # no wrap in z
+    # cKDTree needs 0 <= x < boxsize
+    xyz[:, 0] = np.where(xyz[:, 0] >= snap.lx, 0.0, xyz[:, 0])
+    xyz[:, 1] = np.where(xyz[:, 1] >= snap.ly, 0.0, xyz[:, 1])
+    return cKDTree(xyz, boxsize=[snap.lx, snap.ly, bz]), xyz
+
+
+def pair_distances(snap: Snapshot, rcut: float):
+    """All pairs (i < j, indices into the snapshot) closer than rcut, with distances (x, y
+    periodic, z open)."""
+    tree, xyz = _tree(snap)
+    pairs = tree.query_pairs(rcut, output_type="ndarray")
+    if len(pairs) == 0:
+        return pairs.reshape(0, 2), np.zeros(0)
+    d = xyz[pairs[:, 0]] - xyz[pairs[:, 1]]
+    d[:, 0] -= snap.lx * np.round(d[:, 0] / snap.lx)
+    d[:, 1] -= snap.ly * np.round(d[:, 1] / snap.ly)
+    return pairs, np.sqrt((d * d).sum(axis=1))
+
+
+def contacts(snap: Snapshot, tol: float = 0.0):
+    """Geometric contacts: pairs with r_ij < r_i + r_j + tol (tol = 0: overlap, the paper's
+    'geometrical contact'). Returns (pairs, overlaps delta = r_i + r_j - r_ij)."""
+    rad = snap["radius"]
+    pairs, dist = pair_distances(snap, 2.0 * rad.max() + tol)
+    if len(pairs) == 0:
+        return pairs, dist
+    ov = rad[pairs[:, 0]] + rad[pairs[:, 1]] - dist
+    keep = ov > -tol
+    return pairs[keep], ov[keep]
+
+
+def coordination(snap: Snapshot, tol: float = 0.0) -> np.ndarray:
+    """Per-particle number of particle-particle contacts (the floor is not counted)."""
+    pairs, _ = contacts(snap, tol)
+    Z = np.zeros(snap.n, dtype=int)
+    np.add.at(Z, pairs[:, 0], 1)
+    np.add.at(Z, pairs[:, 1], 1)
+    return Z
+
+
+def coordination_stats(snap: Snapshot, zlo: float, zhi: float, tol: float = 0.0, zmax_bins=12):
+    """<Z> and f(Z) over the particles whose centres lie in [zlo, zhi]."""
+    Z = coordination(snap, tol)
+    sel = (snap["z"] >= zlo) & (snap["z"] <= zhi)
+    Zs = Z[sel]
+    f = np.bincount(Zs, minlength=zmax_bins + 1)[: zmax_bins + 1].astype(float)
+    f /= max(len(Zs), 1)
+    return {"Z": float(Zs.mean()) if len(Zs) else float("nan"), "fZ": f.tolist(),
+            "n_slab": int(sel.sum()), "Z_all": Z}
+
+
+def rdf_slab(snap: Snapshot, zlo: float, zhi: float, rmax: float, nbins: int = 200):
+    """g(r) of the particles with centres in [zlo, zhi] (both members of a pair in the slab),
+    normalised for the slab: the ideal count for reference i in the shell [r, r + dr] is
+    rho_s * 2 pi r * |[z_i - r, z_i + r] n [zlo, zhi]| * dr (area of a spherical zone), with
+    rho_s = N_s / (L_x L_y (zhi - zlo)); x, y periodic. Returns (r centres, g)."""
+    sel = np.flatnonzero((snap["z"] >= zlo) & (snap["z"] <= zhi))
+    sub = Snapshot(snap.step, snap.box, {k: v[sel] for k, v in snap.cols.items()})
+    pairs, dist = pair_distances(sub, rmax)
+    edges = np.linspace(0.0, rmax, nbins + 1)
+    counts = np.histogram(dist, bins=edges)[0] * 2.0
+    rc = 0.5 * (edges[:-1] + edges[1:])
+    dr = edges[1] - edges[0]
+    rho_s = len(sel) / (snap.lx * snap.ly * (zhi - zlo))
+    z = sub["z"][:, None]
+    overlap = np.clip(np.minimum(z + rc, zhi) - np.maximum(z - rc, zlo), 0.0, None)
+    ideal = rho_s * 2.0 * math.pi * rc * overlap.sum(axis=0) * dr
+    g = np.where(ideal > 0, counts / np.where(ideal > 0, ideal, 1.0), 0.0)
+    return rc, g
+
+
+def analyse(snap: Snapshot, rp: float, zlo_rp=4.0, top_rp=6.0, tol=0.0) -> dict:
+    """phi, <Z>, f(Z) of the analysis slab of a final snapshot (the decks' rule)."""
+    zlo, zhi = analysis_slab(snap, rp, zlo_rp, top_rp)
+    out = {"zlo": zlo, "zhi": zhi, "slab_thickness_rp": (zhi - zlo) / rp}
+    if zhi - zlo < 2.0 * rp:
+        out.update({"phi": float("nan"), "Z": float("nan"), "fZ": [], "n_slab": 0,
+                    "warning": "bed too thin for the analysis slab"})
+        return out
+    out["phi"] = phi_slab(snap, zlo, zhi)
+    cs = coordination_stats(snap, zlo, zhi, tol)
+    out.update({k: cs[k] for k in ("Z", "fZ", "n_slab")})
+    return out

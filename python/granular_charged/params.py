@@ -1,0 +1,142 @@
+"""Physical parameters, JKR scales and the paper's dimensionless groups.
+
+References: ``physics.md`` sections 1-2 of the project, i.e. Chen, Li, Liu & Makse, Soft Matter
+2016 (arXiv:1509.07012; "the paper"), its Table 1, Eqs. 1-2 (JKR), 7-8 (U_eff, Ad*), and
+Marshall, J. Comput. Phys. 228 (2009) 1541. SI units throughout.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+
+E0 = 1.602176634e-19        # elementary charge [C]
+EPS0 = 8.8541878128e-12     # vacuum permittivity [F/m]
+QQR2E_LAMMPS_SI = 8.9876e9  # LAMMPS's 'units si' Coulomb constant (physics.md sec. 4)
+K_EFF_PAPER = 51.0          # the paper's K_eff = 20 N_tot (L/r_p)^-2 with N_tot = 2000, L = 28 r_p
+
+
+@dataclass
+class DepositionParams:
+    """Inputs of examples/deposition/in.deposition; defaults = the paper's Table 1 / Fig. 2."""
+    rp: float = 2.0e-6        # particle radius [m]
+    U0: float = 1.0           # injection speed [m/s]
+    gamma: float = 0.010      # surface energy per surface [J/m^2]
+    q: float = 0.0            # charge per particle [e_0]
+    N: int = 2000             # particles injected
+    seed: int = 4711
+    farfield: str = "exact"   # fix coul/fmm far field
+    rho: float = 2500.0
+    E: float = 2.0e8
+    nu: float = 0.33
+    e: float = 0.7
+    mu: float = 0.3
+    theta_crit: float = 0.01
+    extra: dict = field(default_factory=dict)   # any other deck variable (gap_rp, dt_div, ...)
+
+    def deck_vars(self) -> dict:
+        d = asdict(self)
+        extra = d.pop("extra")
+        d.update(extra)
+        return {k: str(v) for k, v in d.items()}
+
+    def key(self) -> str:
+        """A file-system friendly name, unique for the swept parameters."""
+        base = (f"rp{self.rp * 1e6:g}um_U{self.U0:g}_g{self.gamma * 1e3:g}mJ_q{self.q:g}"
+                f"_N{self.N}_s{self.seed}")
+        if self.q:
+            base += f"_{self.farfield}"
+        for k in sorted(self.extra):
+            base += f"_{k}{self.extra[k]}"
+        return base.replace("/", "-")
+
+    # derived -------------------------------------------------------------------------------
+    @property
+    def mass(self) -> float:
+        return 4.0 / 3.0 * math.pi * self.rp ** 3 * self.rho
+
+    @property
+    def L(self) -> float:
+        return float(self.extra.get("L_rp", 28)) * self.rp
+
+    def groups(self) -> dict:
+        return dimensionless(self.gamma, self.rho, self.U0, self.rp, self.q)
+
+
+def pair_modulus(E: float, nu: float) -> float:
+    """E* of two like spheres: 1/E* = 2 (1 - nu^2)/E (physics.md sec. 1)."""
+    return E / (2.0 * (1.0 - nu * nu))
+
+
+def contact_time(rp: float, rho: float, E: float, nu: float, U0: float) -> float:
+    """Hertz collision time of two like spheres at relative speed U0 (physics.md sec. 1):
+    t_c = 2.87 (m*^2 / (R E*^2 v))^(1/5), R = r_p/2, m* = m/2."""
+    m = 4.0 / 3.0 * math.pi * rp ** 3 * rho
+    return 2.87 * ((0.5 * m) ** 2 / (0.5 * rp * pair_modulus(E, nu) ** 2 * U0)) ** 0.2
+
+
+def time_step(rp, rho, E, nu, U0, dt_div=20.0) -> float:
+    """The decks' rule: dt = t_c / dt_div (default 20)."""
+    return contact_time(rp, rho, E, nu, U0) / dt_div
+
+
+def jkr_scales(R: float, Estar: float, gamma: float) -> dict:
+    """F_C = 3 pi gamma R, a_0 = (9 pi gamma R^2 / E*)^(1/3), delta_C = a_0^2 / (2 6^(1/3) R)."""
+    FC = 3.0 * math.pi * gamma * R
+    a0 = (9.0 * math.pi * gamma * R * R / Estar) ** (1.0 / 3.0)
+    dC = a0 * a0 / (2.0 * 6.0 ** (1.0 / 3.0) * R)
+    return {"FC": FC, "a0": a0, "deltaC": dC}
+
+
+def jkr_force_of_overlap(delta, R, Estar, gamma):
+    """Elastic-adhesive normal force F_ne(delta) (> 0 repulsive) on the attached JKR branch,
+    from F/F_C = 4 (a^3 - a^1.5) and delta/delta_C = 6^(1/3) (2 a^2 - 4/3 a^0.5) (physics.md
+    sec. 1; the squared form, not the paper's typo). Valid for -delta_C <= delta; vectorised."""
+    import numpy as np
+    s = jkr_scales(R, Estar, gamma)
+    d = np.atleast_1d(np.asarray(delta, dtype=float)) / s["deltaC"]
+    a_min = 6.0 ** (-2.0 / 3.0)   # separation point: delta = -delta_C
+    out = np.empty_like(d)
+    for k, dk in enumerate(d):
+        # delta(a) is increasing for a >= a_min: bisection on the attached branch
+        lo, hi = a_min, max(2.0, (abs(dk) + 2.0) ** 0.5)
+        f = lambda a: 6.0 ** (1.0 / 3.0) * (2.0 * a * a - 4.0 / 3.0 * math.sqrt(a)) - dk
+        if f(lo) > 1e-9:
+            out[k] = math.nan
+            continue
+        for _ in range(80):
+            mid = 0.5 * (lo + hi)
+            if f(mid) > 0:
+                hi = mid
+            else:
+                lo = mid
+        a = 0.5 * (lo + hi)
+        out[k] = 4.0 * (a ** 3 - a ** 1.5)
+    return out * s["FC"]
+
+
+def dimensionless(gamma, rho, U0, rp, q_e0, K_eff=K_EFF_PAPER) -> dict:
+    """The paper's Sec. 4.2 groups.
+
+    Ad = gamma / (rho U0^2 r_p)                              (dimensionless: J/m^2 / (kg/m^3 m^2/s^2 m))
+    E* = K_eff q^2 / (eps0 U0^2 r_p^4 rho)                   (C^2 / (F/m m^2/s^2 m^4 kg/m^3) = 1)
+    U_eff^2 = U0^2 (1 - E*),  Ad* = gamma / (rho U_eff^2 r_p)  (Eqs. 7-8)
+
+    Units check: q = 400 e_0, r_p = 2 um, U0 = 1 m/s, rho = 2500 gives E* = 0.59 < 1 and
+    E* = 1 at q ~ 520 e_0, as in physics.md sec. 2. Ad* is infinite (returned as inf) when
+    E* >= 1 (injected particles cannot reach the bed).
+    """
+    q = q_e0 * E0
+    Ad = gamma / (rho * U0 ** 2 * rp)
+    Estar = K_eff * q * q / (EPS0 * U0 ** 2 * rp ** 4 * rho)
+    Ueff2 = U0 ** 2 * (1.0 - Estar)
+    Adstar = gamma / (rho * Ueff2 * rp) if Ueff2 > 0 else math.inf
+    return {"Ad": Ad, "Estar": Estar, "Adstar": Adstar, "Ueff": math.sqrt(max(Ueff2, 0.0))}
+
+
+def coulomb_to_adhesion(gamma, rp, q_e0) -> float:
+    """F_C / F_E with F_C = 3 pi gamma R (R = r_p/2) and F_E = q^2 / (4 pi eps0 (2 r_p)^2)
+    (two touching charged spheres). The paper quotes ~1e4 for its Table 2."""
+    q = q_e0 * E0
+    FC = 3.0 * math.pi * gamma * rp / 2.0
+    FE = q * q / (4.0 * math.pi * EPS0 * (2.0 * rp) ** 2)
+    return FC / FE if FE > 0 else math.inf
