@@ -4,6 +4,8 @@
 // Notation and conventions: include/gcfmm/lattice_sum.hpp and doc/fmm-far-field.md.
 #include "gcfmm/lattice_sum.hpp"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -295,7 +297,7 @@ bool PeriodicFarField::needs_setup(double x0, double y0, double lx, double ly, d
 
 std::size_t PeriodicFarField::memory_bytes() const {
   std::size_t b = 0;
-  for (const auto &m : ops_) b += sizeof(double) * static_cast<std::size_t>(m.size());
+  for (const auto &m : ops_) b += sizeof(double) * m.size();
   return b;
 }
 
@@ -435,11 +437,11 @@ void PeriodicFarField::setup_explicit(double x0, double y0, double lx, double ly
   //   K_s[(a,b,c),(a',b',c')] = sum_{gx,gy in {0,1}} sx^gx sy^gy M_o[(a,b,c),(m_gx(a'),m_gy(b'),c')]
   // for a, b, a', b' < p/2 (m_1(a) = p-1-a): 4 times less memory and work.
   const int h = pxy / 2, nh = h * h * pz;
-  ops_.assign(4 * static_cast<std::size_t>(nb_), Eigen::MatrixXd::Zero(nh, nh));
+  ops_.assign(4 * static_cast<std::size_t>(nb_), std::vector<double>(static_cast<std::size_t>(nh) * nh, 0.0));
   for (int o = 0; o < nb_; ++o)
     for (int sym = 0; sym < 4; ++sym) {
       const double sx = (sym & 1) ? -1.0 : 1.0, sy = (sym & 2) ? -1.0 : 1.0;
-      Eigen::MatrixXd &m = ops_[4 * o + sym];
+      Eigen::Map<Eigen::MatrixXd> m(ops_[4 * o + sym].data(), nh, nh);
       for (int a2 = 0; a2 < h; ++a2)
         for (int b2 = 0; b2 < h; ++b2)
           for (int c2 = 0; c2 < pz; ++c2) {
@@ -468,9 +470,11 @@ void PeriodicFarField::setup_explicit(double x0, double y0, double lx, double ly
   setup_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
 }
 
-void PeriodicFarField::to_sym(const Eigen::MatrixXd &w, Eigen::MatrixXd *v) const {
+namespace {
+
+void to_sym(int p, int pz, const Eigen::MatrixXd &w, Eigen::MatrixXd *v) {
   // v_s(a,b,c) = 1/4 sum_{gx,gy} sx^gx sy^gy w(m_gx(a), m_gy(b), c), a, b < p/2
-  const int p = pxy_, h = p / 2, pz = pz_;
+  const int h = p / 2;
   for (int sym = 0; sym < 4; ++sym) v[sym].resize(h * h * pz, w.cols());
   for (Eigen::Index col = 0; col < w.cols(); ++col)
     for (int a = 0; a < h; ++a)
@@ -490,9 +494,9 @@ void PeriodicFarField::to_sym(const Eigen::MatrixXd &w, Eigen::MatrixXd *v) cons
       }
 }
 
-void PeriodicFarField::from_sym(const Eigen::MatrixXd *u, Eigen::MatrixXd &phi) const {
+void from_sym(int p, int pz, const Eigen::MatrixXd *u, Eigen::MatrixXd &phi) {
   // phi(m_fx(a), m_fy(b), c) = sum_s sx^fx sy^fy u_s(a,b,c)
-  const int p = pxy_, h = p / 2, pz = pz_;
+  const int h = p / 2;
   phi.resize(p * p * pz, u[0].cols());
   for (Eigen::Index col = 0; col < u[0].cols(); ++col)
     for (int a = 0; a < h; ++a)
@@ -512,19 +516,24 @@ void PeriodicFarField::from_sym(const Eigen::MatrixXd *u, Eigen::MatrixXd &phi) 
       }
 }
 
-void PeriodicFarField::apply(const Eigen::MatrixXd &w, Eigen::MatrixXd &phi) const {
-  Eigen::MatrixXd v[4], u[4];
-  to_sym(w, v);
+}  // namespace
+
+void PeriodicFarField::apply(const double *wp, double *phip) const {
+  const int nn = pxy_ * pxy_ * pz_, nh = nn / 4;
+  const Eigen::Map<const Eigen::MatrixXd> w(wp, nn, nb_);
+  Eigen::MatrixXd v[4], u[4], phi;
+  to_sym(pxy_, pz_, w, v);
   for (int sym = 0; sym < 4; ++sym) {
-    u[sym].noalias() = ops_[sym] * v[sym];
+    u[sym].noalias() = Eigen::Map<const Eigen::MatrixXd>(ops_[sym].data(), nh, nh) * v[sym];
     for (int o = 1; o < nb_; ++o) {
       // target t = s + o (offset +o): K_o; target t = s - o: K_{-o} = K_o^T
-      const Eigen::MatrixXd &k = ops_[4 * o + sym];
+      const Eigen::Map<const Eigen::MatrixXd> k(ops_[4 * o + sym].data(), nh, nh);
       u[sym].rightCols(nb_ - o).noalias() += k * v[sym].leftCols(nb_ - o);
       u[sym].leftCols(nb_ - o).noalias() += k.transpose() * v[sym].rightCols(nb_ - o);
     }
   }
-  from_sym(u, phi);
+  from_sym(pxy_, pz_, u, phi);
+  Eigen::Map<Eigen::MatrixXd>(phip, nn, nb_) = phi;
 }
 
 int PeriodicFarField::locate(std::size_t i, double x, double y, double z, double *tx, double *ty,
@@ -542,7 +551,7 @@ int PeriodicFarField::locate(std::size_t i, double x, double y, double z, double
   return b;
 }
 
-void PeriodicFarField::interpolate(const Eigen::MatrixXd &phi, const double *x, const double *y,
+void PeriodicFarField::interpolate(const double *phi, const double *x, const double *y,
                                    const double *z, std::size_t begin, std::size_t end, double *pot,
                                    double *ex, double *ey, double *ez) const {
   const int p = pxy_, pz = pz_;
@@ -554,7 +563,7 @@ void PeriodicFarField::interpolate(const Eigen::MatrixXd &phi, const double *x, 
     interp_weights(tx, p, tab_xy_.data(), sx, dsx);
     interp_weights(ty, p, tab_xy_.data(), sy, dsy);
     interp_weights(tz, pz, tab_z_.data(), sz, dsz);
-    const double *col = phi.col(b).data();
+    const double *col = phi + static_cast<std::size_t>(b) * p * p * pz;
     double f = 0, gx = 0, gy = 0, gz = 0;
     for (int a = 0; a < p; ++a) {
       double fa = 0, fya = 0, fza = 0;
@@ -603,25 +612,26 @@ double PeriodicFarField::sample_error() const {
       for (int b = 0; b < p; ++b)
         for (int c = 0; c < pz; ++c) w1((a * p + b) * pz + c, 0) = sx[a] * sy[b] * sz[c];
     Eigen::MatrixXd v[4], u[4], phi;
-    to_sym(w1, v);
+    to_sym(p, pz, w1, v);
     for (int sym = 0; sym < 4; ++sym) {
       u[sym].resize(v[sym].rows(), nb_);
       for (int t = 0; t < nb_; ++t) {
         const int o = t - bs;
         if (o >= 0)
-          u[sym].col(t).noalias() = ops_[4 * o + sym] * v[sym].col(0);
+          u[sym].col(t).noalias() = Eigen::Map<const Eigen::MatrixXd>(ops_[4 * o + sym].data(), nn / 4, nn / 4) * v[sym].col(0);
         else
-          u[sym].col(t).noalias() = ops_[4 * (-o) + sym].transpose() * v[sym].col(0);
+          u[sym].col(t).noalias() =
+              (v[sym].col(0).transpose() * Eigen::Map<const Eigen::MatrixXd>(ops_[4 * (-o) + sym].data(), nn / 4, nn / 4)).transpose();
       }
     }
-    from_sym(u, phi);
+    from_sym(p, pz, u, phi);
     for (int t = 0; t < nt; ++t) {
       xt[t] = x0_ + lx_ * u01(rng);
       yt[t] = y0_ + ly_ * u01(rng);
       zt[t] = zlo_ + (zhi_ - zlo_) * u01(rng);
       ex[t] = ey[t] = ez[t] = 0.0;
     }
-    interpolate(phi, xt.data(), yt.data(), zt.data(), 0, nt, nullptr, ex.data(), ey.data(), ez.data());
+    interpolate(phi.data(), xt.data(), yt.data(), zt.data(), 0, nt, nullptr, ex.data(), ey.data(), ez.data());
     for (int t = 0; t < nt; ++t) {
       double gx, gy, gz;
       far_kernel(xt[t] - xs, yt[t] - ys, zt[t] - zs, lx_, ly_, images_, nullptr, &gx, &gy, &gz);
@@ -659,8 +669,8 @@ void PeriodicFarField::evaluate(std::size_t n, const double *x, const double *y,
     }
   }
   Eigen::MatrixXd phi(nn, nb_);
-  apply(w, phi);
-  interpolate(phi, x, y, z, begin, end, pot, ex, ey, ez);
+  apply(w.data(), phi.data());
+  interpolate(phi.data(), x, y, z, begin, end, pot, ex, ey, ez);
 }
 
 }  // namespace gcfmm

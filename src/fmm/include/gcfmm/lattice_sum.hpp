@@ -1,6 +1,8 @@
 // GRANULAR-CHARGED FMM core library (gcfmm).
 // 2D-periodic (x, y periodic; z open) lattice sums of the bare 1/r kernel and the exact far
-// field of all image cells beyond the near block. No LAMMPS headers; only std and Eigen.
+// field of all image cells beyond the near block. No LAMMPS headers; only std (Eigen is used
+// inside the library only, so that callers built with other vectorisation flags share no
+// Eigen objects with it).
 //
 // Notation (Gaussian units, the caller multiplies by its Coulomb constant):
 //   cell periods lx, ly; area A = lx * ly; image shift n = (nx lx, ny ly, 0);
@@ -8,8 +10,6 @@
 // See doc/fmm-far-field.md for the derivations, error control and measured costs.
 #ifndef GCFMM_LATTICE_SUM_HPP
 #define GCFMM_LATTICE_SUM_HPP
-
-#include <Eigen/Dense>
 
 #include <cstddef>
 #include <vector>
@@ -155,11 +155,9 @@ class PeriodicFarField {
 
  private:
   static void interp_weights(double t, int p, const double *tab, double *s, double *ds);
-  void apply(const Eigen::MatrixXd &w, Eigen::MatrixXd &phi) const;
-  void to_sym(const Eigen::MatrixXd &w, Eigen::MatrixXd *v) const;
-  void from_sym(const Eigen::MatrixXd *u, Eigen::MatrixXd &phi) const;
+  void apply(const double *w, double *phi) const;  // node charges -> node potentials, (p^2 pz) x nb
   int locate(std::size_t i, double x, double y, double z, double *tx, double *ty, double *tz) const;
-  void interpolate(const Eigen::MatrixXd &phi, const double *x, const double *y, const double *z,
+  void interpolate(const double *phi, const double *x, const double *y, const double *z,
                    std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
                    double *ez) const;
   double sample_error() const;
@@ -173,7 +171,7 @@ class PeriodicFarField {
   double hz_ = 0;                             //!< box height
   double est_error_ = 0;                      //!< sampled relative kernel error
   double setup_s_ = 0;                        //!< set-up wall time
-  std::vector<Eigen::MatrixXd> ops_;          //!< blocks K_{o,s} at 4 o + s, offsets o = 0 .. nb-1
+  std::vector<std::vector<double>> ops_;      //!< blocks K_{o,s} (column-major) at 4 o + s, o = 0 .. nb-1
   std::vector<double> tab_xy_, tab_z_;        //!< T_k(t_i) at the Chebyshev nodes
 };
 
