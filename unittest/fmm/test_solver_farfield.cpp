@@ -71,3 +71,13 @@ TEST(SolverFarField, AverageHook) {
   EXPECT_GT(dz, 0.0);
 }
 #endif
+
+#if __has_include("gcfmm/average_field.hpp")
+// A single charged particle (bed of zero height by the automatic bed range) must not fail.
+TEST(SolverFarField, AverageWithFlatBed) {
+  auto p = gcfmm_test::deposition(300, 115);
+  for (std::size_t i = 1; i < p.size(); ++i) p.q[i] = 0.0;
+  Field f = periodic_run(p, FarField::Average);
+  for (std::size_t i = 0; i < p.size(); ++i) EXPECT_TRUE(std::isfinite(f.ez[i]));
+}
+#endif

@@ -231,8 +231,10 @@ void Solver::build(std::size_t n, const double *x, const double *y, const double
 
   if (I.periodic() && I.opts.farfield == FarField::Exact) {
 #if GCFMM_HAVE_LATTICE_SUM
-    if (I.far.needs_setup(I.x0, I.y0, I.lx, I.ly, I.zmin, I.zmax, I.opts.images, I.opts.accuracy))
-      I.far.setup(I.x0, I.y0, I.lx, I.ly, I.zmin, I.zmax, I.opts.images, I.opts.accuracy);
+    // the lattice sum accepts accuracies down to 1e-8 (its far field is smooth and tiny anyway)
+    const double facc = std::max(I.opts.accuracy, 1e-8);
+    if (I.far.needs_setup(I.x0, I.y0, I.lx, I.ly, I.zmin, I.zmax, I.opts.images, facc))
+      I.far.setup(I.x0, I.y0, I.lx, I.ly, I.zmin, I.zmax, I.opts.images, facc);
     s.estimated_error += I.far.estimated_error();
 #else
     throw std::runtime_error("gcfmm: FarField::Exact is not available in this build (no lattice_sum.hpp)");
@@ -378,6 +380,13 @@ void Solver::evaluate(const double *q, double *pot, double *ex, double *ey, doub
           any = true;
         }
       if (!any) blo = bhi = NAN;
+    }
+    if (!std::isnan(blo) && !(bhi - blo > 1e-6 * std::min(I.lx, I.ly))) {
+      // a flat layer of charges (e.g. one charged particle): the slab becomes a sheet; give it
+      // a small thickness (relative change of the far field ~ 1e-6)
+      const double mid = 0.5 * (blo + bhi), h = 0.5e-6 * std::min(I.lx, I.ly);
+      blo = mid - h;
+      bhi = mid + h;
     }
     if (!std::isnan(blo))
       average_far_field(n, xs.data(), ys.data(), zs.data(), I.qs.data(), I.x0, I.y0, I.lx, I.ly, I.opts.images, blo,
