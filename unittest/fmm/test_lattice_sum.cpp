@@ -414,6 +414,25 @@ TEST(PeriodicFarField, ThinNeutralLayerRectangularCell) {
   check_far_field(d, 28, 20, 10, 12, "thin neutral layer 28x20");
 }
 
+TEST(PeriodicFarField, TwoImageShells) {
+  // images = 2: the excluded images are two cells away, the kernel is smoother than with one
+  // shell, so the parameters calibrated for images = 1 must meet the accuracy with margin.
+  const Config c = deposition(800, false, 13);
+  const auto targets = sample_targets(c.size(), 64);
+  const auto ref = reference_far(c, targets, 28, 28, 2);
+  for (double acc : {1e-4, 1e-6}) {
+    PeriodicFarField f;
+    f.setup(0, 0, 28, 28, 0, 160, 2, acc);
+    std::vector<double> ex(c.size(), 0), ey(c.size(), 0), ez(c.size(), 0);
+    f.evaluate(c.size(), c.x.data(), c.y.data(), c.z.data(), c.q.data(), 0, c.size(), nullptr, ex.data(),
+               ey.data(), ez.data());
+    const double err = rel_rms_error(ref, ex, ey, ez, targets);
+    std::printf("  images 2, +-q, accuracy %.0e: relative RMS error %.2e\n", acc, err);
+    EXPECT_LT(err, acc);
+    EXPECT_GT(err, 1e-13);
+  }
+}
+
 TEST(PeriodicFarField, NetChargedLayerSheetFieldFarAbove) {
   // 300 unit charges in 0 < z < 5, probe (q = 0) at z = 150: the total field (near block
   // summed directly here + far field) is the sheet field 2 pi Q / A up to the k != 0 terms,

@@ -61,7 +61,9 @@ double green_switch_height(double lx, double ly) { return kSwitch * std::min(lx,
 void periodic_green_fourier(double dx, double dy, double dz, double lx, double ly, double *g,
                             double *gx, double *gy, double *gz) {
   check_periods(lx, ly);
-  if (dz == 0.0) throw std::invalid_argument("gcfmm::periodic_green_fourier: needs dz != 0");
+  if (!(std::fabs(dz) >= 0.01 * std::min(lx, ly)))
+    throw std::invalid_argument(
+        "gcfmm::periodic_green_fourier: needs |dz| >= 0.01 min(lx, ly) (use periodic_green)");
   dx = reduce(dx, lx);
   dy = reduce(dy, ly);
   const double az = std::fabs(dz), sg = dz > 0 ? 1.0 : -1.0;

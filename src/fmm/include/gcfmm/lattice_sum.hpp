@@ -51,7 +51,8 @@ void periodic_green(double dx, double dy, double dz, double lx, double ly, doubl
 
 /**
  * @brief The pure Fourier form of periodic_green (see above), truncated where exp(-|k||dz|)
- * < 1e-17. Fast for |dz| >~ min(lx, ly) / 2; cost grows like 1/dz^2. @pre dz != 0.
+ * < 1e-17. Fast for |dz| >~ min(lx, ly) / 2; cost grows like 1/dz^2.
+ * @throws std::invalid_argument if |dz| < 0.01 min(lx, ly).
  */
 void periodic_green_fourier(double dx, double dy, double dz, double lx, double ly, double *g,
                             double *gx, double *gy, double *gz);
