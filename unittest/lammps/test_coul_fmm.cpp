@@ -262,6 +262,87 @@ TEST(CoulFMM, BadInput)
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm every 0"), "every must be >= 1, got 0");
 }
 
+// per-atom output (Ex, Ey, Ez, phi), every N, fix_modify virial, dielectric
+TEST(CoulFMM, PerAtomFieldEveryVirialDielectric)
+{
+  if (nprocs() > 1) GTEST_SKIP();
+  // per-atom field: F = q E exactly; energy = 1/2 sum q phi
+  {
+    Lmp l;
+    random_charges(l, "p p f", 200, 20.0, 40.0, 17);
+    l.cmds({"fix fmm all coul/fmm accuracy 1e-6", "variable fxe atom q*f_fmm[1]-fx",
+            "variable ue atom 0.5*q*f_fmm[4]", "compute sfx all reduce sumabs v_fxe",
+            "compute ue all reduce sum v_ue", "run 0 post no"});
+    EXPECT_LT(l.var("c_sfx"), 1e-12 * l.var("sqrt(c_ue^2)"));
+    EXPECT_NEAR(l.var("c_ue"), l.var("f_fmm"), 1e-12 * std::fabs(l.var("f_fmm")));
+  }
+  // every 5: between evaluations the stored field is applied; moving atoms feel the field of
+  // the last evaluation until the next one
+  {
+    Lmp l;
+    random_charges(l, "p p f", 200, 20.0, 40.0, 17);
+    l.cmds({"velocity all create 300 5 loop geom", "fix nve all nve", "timestep 1.0",
+            "fix fmm all coul/fmm accuracy 1e-6 every 5", "run 0 post no"});
+    const auto f0 = gather(l, "f", 3);
+    const auto q0 = gather(l, "q", 1);
+    l.cmd("run 3 post no");
+    const auto f3 = gather(l, "f", 3);
+    EXPECT_EQ(rel_rms(f3, f0), 0.0) << "steps 1-4 reuse the field of step 0";
+    l.cmd("run 2 post no");
+    EXPECT_GT(rel_rms(gather(l, "f", 3), f0), 1e-8) << "step 5 recomputes";
+  }
+  // virial in free space: sum x_i F_i equals the pairwise virial of coul/cut
+  {
+    Lmp l;
+    random_charges(l, "f f f", 300, 30.0, 30.0, 8);
+    l.cmds({"pair_style coul/cut 100.0", "pair_coeff * *", "compute p all pressure NULL virial",
+            "thermo_style custom step c_p[1] c_p[3] c_p[6]", "run 0 post no"});
+    const double pxx = l.var("c_p[1]"), pzz = l.var("c_p[3]"), pyz = l.var("c_p[6]");
+    l.cmds({"pair_style zero 1.0", "pair_coeff * *", "fix fmm all coul/fmm accuracy 1e-6",
+            "fix_modify fmm virial yes", "run 0 post no"});
+    const double scale = std::fabs(pxx) + std::fabs(pzz);
+    EXPECT_NEAR(l.var("c_p[1]"), pxx, 1e-5 * scale);
+    EXPECT_NEAR(l.var("c_p[3]"), pzz, 1e-5 * scale);
+    EXPECT_NEAR(l.var("c_p[6]"), pyz, 1e-5 * scale);
+  }
+  // the dielectric constant divides all Coulomb forces (force->qqrd2e)
+  {
+    Lmp l1, l2;
+    random_charges(l1, "p p f", 100, 20.0, 40.0, 3);
+    random_charges(l2, "p p f", 100, 20.0, 40.0, 3);
+    l1.cmds({"fix fmm all coul/fmm", "run 0 post no"});
+    l2.cmds({"dielectric 2.0", "fix fmm all coul/fmm", "run 0 post no"});
+    auto f1 = gather(l1, "f", 3), f2 = gather(l2, "f", 3);
+    for (auto &v : f2) v *= 2.0;
+    EXPECT_LT(rel_rms(f2, f1), 1e-14);
+  }
+}
+
+// a run continued from a restart file equals the uninterrupted run
+TEST(CoulFMM, Restart)
+{
+  if (nprocs() > 1) GTEST_SKIP();
+  const std::string file = "coul_fmm.restart";
+  std::vector<double> straight, restarted;
+  {
+    Lmp l;
+    random_charges(l, "p p m", 200, 20.0, 40.0, 21);    // m: shrink-wrapped open z
+    l.cmds({"mass 1 1000.0", "velocity all create 300 5 loop geom", "fix nve all nve",
+            "timestep 0.5",
+            "fix fmm all coul/fmm accuracy 1e-6", "run 20 post no", "write_restart " + file,
+            "run 20 post no"});
+    straight = gather(l, "x", 3);
+  }
+  {
+    Lmp l;
+    l.cmds({"read_restart " + file, "fix nve all nve", "fix fmm all coul/fmm accuracy 1e-6",
+            "run 20 post no"});
+    restarted = gather(l, "x", 3);
+  }
+  std::remove(file.c_str());
+  EXPECT_LT(rel_rms(restarted, straight), 1e-13);
+}
+
 // 1 and 2 ranks agree to 1e-12 (every target is computed by one rank, in the same order)
 TEST(CoulFMM, OneVersusTwoRanks)
 {
