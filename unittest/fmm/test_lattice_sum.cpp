@@ -503,6 +503,26 @@ TEST(PeriodicFarField, ZeroNetForceAndPotentialAtProbe) {
   EXPECT_LT(std::fabs(pot[n - 1] - pr), 1e-6 * 600 * 2 * kPi / (28.0 * 28.0) * 28);
 }
 
+TEST(PeriodicFarField, TargetRangesAddAndAgree) {
+  // evaluate ADDS, and splitting the targets into ranges (as the caller does per rank or
+  // thread) gives the same numbers: same node charges, same operator, same interpolation, so
+  // agreement is to the last bit up to the added offset (1e-15 relative).
+  Config c = deposition(300, false, 14);
+  const std::size_t n = c.size(), k = 137;
+  PeriodicFarField f;
+  f.setup(0, 0, 28, 28, 0, 160, 1, 1e-4);
+  std::vector<double> p1(n, 0), x1(n, 0), y1(n, 0), z1(n, 0), p2(n, 1), x2(n, 1), y2(n, 1), z2(n, 1);
+  f.evaluate(n, c.x.data(), c.y.data(), c.z.data(), c.q.data(), 0, n, p1.data(), x1.data(), y1.data(), z1.data());
+  f.evaluate(n, c.x.data(), c.y.data(), c.z.data(), c.q.data(), 0, k, p2.data(), x2.data(), y2.data(), z2.data());
+  f.evaluate(n, c.x.data(), c.y.data(), c.z.data(), c.q.data(), k, n, p2.data(), x2.data(), y2.data(), z2.data());
+  for (std::size_t i = 0; i < n; ++i) {
+    EXPECT_NEAR(p2[i] - 1, p1[i], 1e-13 * (1 + std::fabs(p1[i])));
+    EXPECT_NEAR(x2[i] - 1, x1[i], 1e-13);
+    EXPECT_NEAR(y2[i] - 1, y1[i], 1e-13);
+    EXPECT_NEAR(z2[i] - 1, z1[i], 1e-13);
+  }
+}
+
 TEST(PeriodicFarField, NeedsSetupAndErrors) {
   PeriodicFarField f;
   EXPECT_TRUE(f.needs_setup(0, 0, 28, 28, 0, 160, 1, 1e-4));
