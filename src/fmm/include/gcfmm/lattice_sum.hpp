@@ -83,14 +83,16 @@ void far_kernel(double dx, double dy, double dz, double lx, double ly, int image
  *
  * Method (black-box FMM of Fong & Darve, J. Comput. Phys. 228 (2009) 8712, applied to the
  * smooth far kernel R above): the column [zlo, zhi] (padded) is split into nb boxes of
- * full cell width and height hz <= min(lx, ly) (0.7 min(lx, ly) at 1e-8); each box carries a tensor Chebyshev
- * grid of p x p x pz nodes; charges are anterpolated to the nodes, the node potentials are
- * M_{t-s} W_s with the precomputed matrices M_o[a, b] = R(node_a - node_b - o hz e_z)
+ * full cell width and height hz <= min(lx, ly) (0.7 min(lx, ly) at 1e-8); each box
+ * carries a tensor Chebyshev grid of p x p x pz nodes; charges are anterpolated to the nodes, the node potentials are
+ * M_{t-s} W_s with the precomputed matrices M_o[a, b] = R(node_a - node_b + o hz e_z)
  * (translation invariant, so one matrix per box offset o, and M_{-o} = M_o^T since R is
  * even), and potential and field at the targets are the Chebyshev interpolant and its
- * derivative. Cost: set-up evaluates R once per distinct node difference (about
- * (p^2/2)^2 nb pz^2 values) and fills nb matrices of size (p^2 pz)^2; evaluate costs
- * O(N p^2 pz + nb^2 (p^2 pz)^2), independent of the particle distribution.
+ * derivative. R is even in dx and dy and the nodes are mirror-symmetric, so each M_o is
+ * block diagonal in even/odd node combinations (4 blocks of size (p^2 pz / 4)^2; p even).
+ * Cost: set-up evaluates R once per distinct |node difference| and fills nb x 4 blocks;
+ * evaluate costs O(N p^2 pz + nb^2 (p^2 pz)^2 / 4), independent of the particle distribution.
+ * Parameters (p, pz, hz) per accuracy and measured errors/costs: doc/fmm-far-field.md.
  *
  * Conventions: pot_i = sum_j q_j R(r_i - r_j) (all j, including j = i: R is smooth at 0 and
  * R(0) is the self-energy of i with its far images), E_i = -grad pot_i. The monopole (sheet
@@ -107,7 +109,8 @@ class PeriodicFarField {
   /**
    * @brief Precompute the operator.
    * @param x0,y0,lx,ly primary cell [x0,x0+lx) x [y0,y0+ly)
-   * @param zlo,zhi     z range containing all particles (stored with headroom)
+   * @param zlo,zhi     z range containing all particles (stored padded by
+   *                    0.1 (zhi - zlo) + 0.1 min(lx, ly) on each side)
    * @param images      near-block shells handled by the caller (>= 1)
    * @param accuracy    requested relative RMS accuracy of the far field, in [1e-8, 1)
    * @throws std::invalid_argument on bad arguments
