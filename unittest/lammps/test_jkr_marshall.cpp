@@ -329,6 +329,40 @@ TEST(JKRMarshall, RollingSpringAndLimit)
   }
 }
 
+// unlike types: E* and G* from both materials, gamma by geometric mean, R from both radii
+TEST(JKRMarshall, MixingUnlikeTypes)
+{
+  const double E1 = 2e8, nu1 = 0.33, g1 = 0.01, r1 = 1e-6, E2 = 5e8, nu2 = 0.25, g2 = 0.04, r2 = 2e-6;
+  Lmp l;
+  l.cmds({"units si", "atom_style sphere", "atom_modify map array", "boundary f f f",
+          "comm_modify vel yes", "region box block -1e-5 1e-5 -1e-5 1e-5 -1e-5 1e-5",
+          "create_box 2 box", "create_atoms 1 single 0 0 0",
+          fmt::format("create_atoms 2 single {} 0 0", r1 + r2), fmt::format("set type 1 diameter {}", 2 * r1),
+          fmt::format("set type 2 diameter {}", 2 * r2), "set type * density 2500", "pair_style granular",
+          fmt::format("pair_coeff 1 1 jkr/marshall {} 1.0 {} {} damping marshall tangential marshall 0.3", E1, nu1, g1),
+          fmt::format("pair_coeff 2 2 jkr/marshall {} 1.0 {} {} damping marshall tangential marshall 0.3", E2, nu2, g2),
+          "neighbor 2e-7 bin", "timestep 1e-9", "group one id 1", "group two id 2"});
+  const double Es = 1.0 / ((1 - nu1 * nu1) / E1 + (1 - nu2 * nu2) / E2);
+  const double Gs = 1.0 / (2 * (2 - nu1) * (1 + nu1) / E1 + 2 * (2 - nu2) * (1 + nu2) / E2);
+  const JKR jkr{r1 * r2 / (r1 + r2), Es, std::sqrt(g1 * g2)};
+  auto fx_at = [&](double delta) {
+    l.cmd(fmt::format("set atom 2 x {:.17g}", r1 + r2 - delta));
+    l.cmd("run 0 post no");
+    return -l.var("fx[1]");
+  };
+  for (double dd : {0.0, 0.5, 2.0, 1.0, -0.3, -0.9})
+    EXPECT_NEAR(fx_at(dd * jkr.deltaC() + 1e-20) / jkr.FC(), jkr.force(dd * jkr.deltaC()) / jkr.FC(), 1e-6) << dd;
+  EXPECT_EQ(fx_at(-1.001 * jkr.deltaC()), 0.0) << "breaks at the mixed delta_C";
+  // tangential stiffness 8 G* a from the mixed G*: slope of the first steps of a slide
+  fx_at(jkr.deltaC());
+  const double a = JKR::ahat_of_delta(1.0) * jkr.a0();
+  l.cmds({"fix hold one move linear 0 0 0", "fix slide two move linear 0 0.001 0", "run 0 post no",
+          "run 5 post no"});
+  const double u = l.var("y[2]-y[1]");
+  // 1e-3: the normal rotates by u/r ~ 1e-5, the spring is read through the y force
+  EXPECT_NEAR(l.var("fy[1]") / (8.0 * Gs * a * u), 1.0, 1e-3);
+}
+
 // 8. bad input: each refused with a message naming the model and the value
 TEST(JKRMarshall, BadInput)
 {
