@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import re
+import resource
 import shutil
 import subprocess
 import sys
@@ -23,6 +23,8 @@ from .params import DepositionParams, coulomb_to_adhesion
 SOURCE_DIR = Path(os.environ.get("GC_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 DECK = SOURCE_DIR / "examples" / "deposition" / "in.deposition"
 RESULT_VERSION = 1
+LAST_TIMES: dict = {}   # wall and CPU seconds (all ranks; approximate when runs overlap) of the
+                        # last run_deck, and the 1-min load average at its end
 
 
 class RunError(RuntimeError):
@@ -112,9 +114,13 @@ def run_deck(workdir: Path, variables: dict, build: Path, np_ranks: int = 1,
             raise RunError("mpirun not found")
         cmd = [mpirun, "-np", str(np_ranks), "--oversubscribe"] + cmd
     t0 = time.monotonic()
+    ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     r = subprocess.run(cmd, env=child_env(build), capture_output=True, text=True,
                        timeout=timeout)
     wall = time.monotonic() - t0
+    ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    LAST_TIMES.update(wall_s=wall, cpu_s=(ru1.ru_utime - ru0.ru_utime) + (ru1.ru_stime - ru0.ru_stime),
+                      load1=os.getloadavg()[0])
     if r.returncode != 0:
         log = workdir / "log.lammps"
         tail = "\n".join(log.read_text(errors="replace").splitlines()[-15:]) if log.exists() else ""
@@ -142,7 +148,8 @@ def run_deposition(p: DepositionParams, root: Path, build: Path | None = None,
         variables["tracer"] = str(tracer)
     wall = run_deck(workdir, variables, build, np_ranks, DECK, timeout)
     res = analyse_run(workdir, p)
-    res.update({"wall_s": wall, "np": np_ranks, "tracer": tracer})
+    res.update({"wall_s": wall, "cpu_s": LAST_TIMES.get("cpu_s"), "load1": LAST_TIMES.get("load1"),
+                "np": np_ranks, "tracer": tracer})
     res_file.write_text(json.dumps(res, indent=1))
     res["skipped"] = False
     return res
