@@ -30,10 +30,38 @@ def write_data(path, n, seed=2016):
     nbed = int(0.9 * n)
     vol = nbed * 4.0 / 3.0 * np.pi * RP**3
     hbed = vol / (0.3 * lx * lx)
+    # random sequential addition of non-overlapping spheres (centres >= 2 r_p apart, periodic
+    # in x and y), as in a real bed: overlapping random points would make the RMS force a
+    # property of a few near-coincident pairs
+    cell = 2 * RP
+    nc = max(1, int(lx // cell))
+    grid = {}
     pos = np.empty((n, 3))
-    pos[:, :2] = rng.uniform(0, lx, (n, 2))
-    pos[:nbed, 2] = rng.uniform(RP, RP + hbed, nbed)
-    pos[nbed:, 2] = rng.uniform(RP + hbed, 160 * RP, n - nbed)
+    k = 0
+    while k < n:
+        zlo, zhi = (RP, RP + hbed) if k < nbed else (RP + hbed, 160 * RP)
+        p = np.array([rng.uniform(0, lx), rng.uniform(0, lx), rng.uniform(zlo, zhi)])
+        ci, cj, ck = int(p[0] / lx * nc) % nc, int(p[1] / lx * nc) % nc, int(p[2] // cell)
+        ok = True
+        for di in (-1, 0, 1):
+            for dj in (-1, 0, 1):
+                for dk in (-1, 0, 1):
+                    for m in grid.get(((ci + di) % nc, (cj + dj) % nc, ck + dk), ()):
+                        d = pos[m] - p
+                        d[:2] -= lx * np.round(d[:2] / lx)
+                        if d @ d < cell * cell:
+                            ok = False
+                            break
+                    if not ok:
+                        break
+                if not ok:
+                    break
+            if not ok:
+                break
+        if ok:
+            pos[k] = p
+            grid.setdefault((ci, cj, ck), []).append(k)
+            k += 1
     with open(path, "w") as f:
         f.write(f"deposition-like charges\n\n{n} atoms\n1 atom types\n\n")
         f.write(f"0 {lx:.17g} xlo xhi\n0 {lx:.17g} ylo yhi\n0 {162*RP:.17g} zlo zhi\n\nAtoms # charge\n\n")
