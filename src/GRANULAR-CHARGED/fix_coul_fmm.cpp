@@ -113,6 +113,9 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
       error->all(FLERR, iarg, "Unknown fix coul/fmm keyword: {}", key);
     }
   }
+  if (opts->images == 0 && opts->farfield == gcfmm::FarField::Exact)
+    error->all(FLERR, "Fix coul/fmm farfield exact needs images >= 1 (the far-field kernel of "
+                      "the exact lattice sum is singular inside the cell for images 0)");
   try {
     opts->validate();
   } catch (std::exception &e) {

@@ -258,6 +258,7 @@ TEST(CoulFMM, BadInput)
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm order 0"), "order must be in \\[1, .*\\], got 0");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm leaf 0"), "leaf must be >= 1, got 0");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm images -1"), "images must be >= 0, got -1");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm images 0"), "farfield exact needs images >= 1");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm farfield maybe"), "farfield must be exact, average or none, got maybe");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm every 0"), "every must be >= 1, got 0");
 }
