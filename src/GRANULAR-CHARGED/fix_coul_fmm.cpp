@@ -59,14 +59,15 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
       need(1);
       opts->accuracy = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
       if (!(opts->accuracy > 0.0 && opts->accuracy < 1.0))
-        error->all(FLERR, iarg + 1, "Fix coul/fmm accuracy must be in (0, 1), got {}", arg[iarg + 1]);
+        error->all(FLERR, iarg + 1, "Fix coul/fmm accuracy must be in (0, 1), got {}",
+                   arg[iarg + 1]);
       iarg += 2;
     } else if (key == "order") {
       need(1);
       opts->order = utils::inumeric(FLERR, arg[iarg + 1], false, lmp);
       if (opts->order < 1 || opts->order > gcfmm::kMaxOrder)
-        error->all(FLERR, iarg + 1, "Fix coul/fmm order must be in [1, {}], got {}", gcfmm::kMaxOrder,
-                   arg[iarg + 1]);
+        error->all(FLERR, iarg + 1, "Fix coul/fmm order must be in [1, {}], got {}",
+                   gcfmm::kMaxOrder, arg[iarg + 1]);
       iarg += 2;
     } else if (key == "theta") {
       need(1);
@@ -89,11 +90,15 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
     } else if (key == "farfield") {
       need(1);
       const std::string v = arg[iarg + 1];
-      if (v == "exact") opts->farfield = gcfmm::FarField::Exact;
-      else if (v == "average") opts->farfield = gcfmm::FarField::Average;
-      else if (v == "none") opts->farfield = gcfmm::FarField::None;
+      if (v == "exact")
+        opts->farfield = gcfmm::FarField::Exact;
+      else if (v == "average")
+        opts->farfield = gcfmm::FarField::Average;
+      else if (v == "none")
+        opts->farfield = gcfmm::FarField::None;
       else
-        error->all(FLERR, iarg + 1, "Fix coul/fmm farfield must be exact, average or none, got {}", v);
+        error->all(FLERR, iarg + 1, "Fix coul/fmm farfield must be exact, average or none, got {}",
+                   v);
       iarg += 2;
     } else if (key == "bed") {
       need(2);
@@ -114,8 +119,9 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
     }
   }
   if (opts->images == 0 && opts->farfield == gcfmm::FarField::Exact)
-    error->all(FLERR, "Fix coul/fmm farfield exact needs images >= 1 (the far-field kernel of "
-                      "the exact lattice sum is singular inside the cell for images 0)");
+    error->all(FLERR,
+               "Fix coul/fmm farfield exact needs images >= 1 (the far-field kernel of "
+               "the exact lattice sum is singular inside the cell for images 0)");
   try {
     opts->validate();
   } catch (std::exception &e) {
@@ -165,8 +171,9 @@ void FixCoulFMM::init()
                px ? "p" : "f", py ? "p" : "f", pz ? "p" : "f");
   }
   if (force->kspace && comm->me == 0)
-    error->warning(FLERR, "Fix coul/fmm is used together with a kspace style: Coulomb "
-                          "interactions may be counted twice");
+    error->warning(FLERR,
+                   "Fix coul/fmm is used together with a kspace style: Coulomb "
+                   "interactions may be counted twice");
   try {
     solver = std::make_unique<gcfmm::Solver>(*opts);
   } catch (std::exception &e) {
@@ -242,7 +249,9 @@ void FixCoulFMM::gather_charges()
   const size_t n = total / 5;
   std::vector<size_t> order(n);
   std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return all[5 * a] < all[5 * b]; });
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return all[5 * a] < all[5 * b];
+  });
   gtag.resize(n);
   gx.resize(n);
   gy.resize(n);
@@ -328,7 +337,8 @@ void FixCoulFMM::compute_field()
                    "FMM Coulomb (fix coul/fmm {}): {} charged atoms, {}\n"
                    "  order = {}, theta = {:.3g}, leaf = {}, levels = {}{}\n"
                    "  estimated relative RMS force error = {:.3g} (requested accuracy {:.3g})\n",
-                   id, n, opts->boundary == gcfmm::Boundary::Free ? "free space" : "periodic in x y",
+                   id, n,
+                   opts->boundary == gcfmm::Boundary::Free ? "free space" : "periodic in x y",
                    st.order, st.theta, st.leaf, st.levels,
                    opts->boundary == gcfmm::Boundary::Free
                        ? std::string()

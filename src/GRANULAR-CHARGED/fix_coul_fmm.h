@@ -51,12 +51,12 @@ class FixCoulFMM : public Fix {
  private:
   std::unique_ptr<gcfmm::Options> opts;    // solver options from the keywords
   std::unique_ptr<gcfmm::Solver> solver;
-  int every;                  // recompute every this many steps
-  bigint last_computed;       // step of the last FMM evaluation (-1: none yet)
-  bool bed_given;             // bed zlo/zhi given by the user (farfield average)
+  int every;               // recompute every this many steps
+  bigint last_computed;    // step of the last FMM evaluation (-1: none yet)
+  bool bed_given;          // bed zlo/zhi given by the user (farfield average)
   double energy_local, energy_all;
   bool energy_summed;
-  double **field;             // per atom: Ex, Ey, Ez, potential (force/charge, energy/charge)
+  double **field;    // per atom: Ex, Ey, Ez, potential (force/charge, energy/charge)
   bool logged;
 
   // gathered charged atoms of the group, sorted by atom ID (identical on every rank)

@@ -41,7 +41,8 @@ void GranSubModDampingMarshall::init()
                "coefficient and E* from it), not {}",
                gm->normal_model->name);
   const double e = jkr->get_restitution();
-  alpha = 1.2728 + e * (-4.2783 + e * (11.087 + e * (-22.348 + e * (27.467 + e * (-18.022 + e * 4.8218)))));
+  alpha = 1.2728 +
+      e * (-4.2783 + e * (11.087 + e * (-22.348 + e * (27.467 + e * (-18.022 + e * 4.8218)))));
   // the fit is 1e-4 off zero at e = 1: no damping means none, and never negative damping
   if (e == 1.0 || alpha < 0.0) alpha = 0.0;
   damp = alpha;

@@ -34,12 +34,12 @@ namespace Granular_NS {
     double pulloff_distance(double, double) override;
     double calculate_forces() override;
 
-    double get_emix() const { return Emix; }                      //!< effective modulus E*
-    double get_gmix() const { return Gmix; }                      //!< effective shear modulus G*
-    double get_restitution() const { return restitution; }        //!< e, for damping marshall
-    double get_pulloff_force() const { return F_pulloff; }        //!< F_C = 3 pi gamma R
-    double get_adhesive_force() const { return F_adhesive; }      //!< 4 F_C (a/a_0)^(3/2)
-    double critical_overlap(double reff) const;                   //!< delta_C for this R
+    double get_emix() const { return Emix; }                    //!< effective modulus E*
+    double get_gmix() const { return Gmix; }                    //!< effective shear modulus G*
+    double get_restitution() const { return restitution; }      //!< e, for damping marshall
+    double get_pulloff_force() const { return F_pulloff; }      //!< F_C = 3 pi gamma R
+    double get_adhesive_force() const { return F_adhesive; }    //!< 4 F_C (a/a_0)^(3/2)
+    double critical_overlap(double reff) const;                 //!< delta_C for this R
 
    protected:
     double restitution;    // e, coefficient of restitution

@@ -44,8 +44,7 @@ void GranSubModRollingMarshall::coeffs_to_local()
 {
   theta_crit = coeffs[0];    // critical rolling angle
   if (!(theta_crit > 0.0))
-    error->all(FLERR, "Illegal marshall rolling model, theta_crit must be > 0, got {}",
-               theta_crit);
+    error->all(FLERR, "Illegal marshall rolling model, theta_crit must be > 0, got {}", theta_crit);
 }
 
 /* ---------------------------------------------------------------------- */

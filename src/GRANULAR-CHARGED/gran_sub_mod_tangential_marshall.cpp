@@ -39,8 +39,8 @@ void GranSubModTangentialMarshall::coeffs_to_local()
   xt = 1.0;          // eta_T = eta_N (Marshall 2009)
   k = 0.0;           // 8 G*, set in init() once the normal model is known
   if (!(mu >= 0.0))
-    error->all(FLERR, "Illegal marshall tangential model, friction coefficient must be >= 0, got {}",
-               mu);
+    error->all(FLERR,
+               "Illegal marshall tangential model, friction coefficient must be >= 0, got {}", mu);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -69,6 +69,7 @@ void GranSubModTangentialMarshall::init()
                  gm->normal_model->name);
     const double E = gm->normal_model->get_emod();
     const double nu = gm->normal_model->get_poiss();
-    k = 8.0 * (gm->contact_type == PAIR ? mix_stiffnessG(E, E, nu, nu) : mix_stiffnessG_wall(E, nu));
+    k = 8.0 *
+        (gm->contact_type == PAIR ? mix_stiffnessG(E, E, nu, nu) : mix_stiffnessG_wall(E, nu));
   }
 }
