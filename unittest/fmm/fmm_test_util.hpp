@@ -44,8 +44,8 @@ inline Particles random_cube(std::size_t n, unsigned seed, double side = 1.0) {
 // particles in a dense bed of volume fraction ~0.3 at the bottom (about 32 high), 10% spread
 // up to z = 160. Equal charges. For other N the box width scales as sqrt(N / 2000) so that
 // the bed keeps its height (lx <= 0: automatic).
-// Bed particles are placed at random with a minimum separation of 1.0 (not a real packing,
-// but the same density and the same short distances that matter for the P2P/M2L balance).
+// Positions are uniformly random (no minimum separation, so not a real packing: same density,
+// and pairs closer than in a packing, which only makes the P2P part harder).
 inline double deposition_width(std::size_t n) { return 28.0 * std::sqrt(double(n) / 2000.0); }
 inline Particles deposition(std::size_t n, unsigned seed, double lx = 0.0, double ly = 0.0, double zmax = 160.0) {
   if (lx <= 0.0) lx = deposition_width(n);
