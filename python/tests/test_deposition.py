@@ -1,14 +1,21 @@
 """End to end: examples/deposition/in.deposition through LAMMPS's Python module at small N.
 
-Small case: N = 250 in L = 10 r_p (2.5 particles per r_p^2 of floor, the paper's 2000 / 28^2 =
-2.55, so the bed is as high as the paper's, ~25 r_p, and K_eff of E* is unchanged), H = 160 r_p,
-injection gap 1 r_p, Coulomb force recomputed every 10 steps. The neutral and the charged run
-(q = 400 e_0, E* = 0.59) use the same seed and run side by side (2 cores): ~1.5-2.5 min.
+Small case: N = 250 in L = 10 r_p (2.5 particles per r_p^2 of floor, as the paper's
+2000 / 28^2 = 2.55, so the bed is as high as the paper's, ~25 r_p, and the K_eff = 51 of its E*
+is unchanged), H = 160 r_p, injection gap 1 r_p, Coulomb force recomputed every 10 steps.
 
-Charged looser than neutral with the same seed: measured here (4 seeds, see doc/deposition.md)
-the charged bed is looser by 0.03-0.05 in phi (neutral 0.40-0.44) while seed-to-seed scatter of
-phi at this size is ~0.01; a single-seed comparison is therefore a safe, non-flaky test.
+Charged looser than neutral: a statistical test over three seeds, q = 0 vs q = 400 e_0
+(E* = 0.59), comparing the seed-averaged phi and <Z>. Measured on this machine (doc/deposition.md),
+seeds 1-4: neutral phi = 0.429, 0.453, 0.428, 0.427 (mean 0.434, sd 0.013), charged phi =
+0.426, 0.417, 0.420, 0.404 (mean 0.417, sd 0.010). A single pair can come out either way at
+this size (seed 1: 0.4288 vs 0.4264, and its <Z> is higher when charged); the means of three
+seeds differ by ~1.9 standard errors. The runs are deterministic for a given build, so the test
+is reproducible here; after a change of the physics it is a fresh draw that would fail with
+~3 % probability even if the charge effect stayed the same: the price of a < 3 min test, the
+effect being weak at this size (doc/deposition.md). Six runs, two at a time: ~2 min on an idle
+2-core machine.
 """
+import statistics
 from concurrent.futures import ThreadPoolExecutor
 
 import pytest
@@ -20,27 +27,29 @@ from granular_charged.runner import lammps_has, run_deposition
 N = 250
 SMALL = {"L_rp": 10, "gap_rp": 1, "coul_every": 10}
 Q = 400.0
-SEED = 1
+SEEDS = (1, 2, 3)
 
 
 @pytest.fixture(scope="module")
 def runs(build_dir, tmp_path_factory):
     root = tmp_path_factory.mktemp("deposition")
     if not lammps_has(build_dir, "fix", "coul/fmm"):
-        pytest.fail(f"fix coul/fmm is missing from {build_dir}: the charged run cannot be done")
-    pn = DepositionParams(q=0.0, N=N, seed=SEED, extra=dict(SMALL))
-    pc = DepositionParams(q=Q, N=N, seed=SEED, extra=dict(SMALL))
+        pytest.fail(f"fix coul/fmm is missing from {build_dir}: the charged runs cannot be done")
+    pn = [DepositionParams(q=0.0, N=N, seed=s, extra=dict(SMALL)) for s in SEEDS]
+    pc = [DepositionParams(q=Q, N=N, seed=s, extra=dict(SMALL)) for s in SEEDS]
     with ThreadPoolExecutor(2) as ex:
-        fn = ex.submit(run_deposition, pn, root, build_dir, tracer=N // 2)
-        fc = ex.submit(run_deposition, pc, root, build_dir)
-        neutral, charged = fn.result(), fc.result()
+        fut = [ex.submit(run_deposition, p, root, build_dir, tracer=N // 2 if p.seed == SEEDS[0] else 0)
+               for p in pc + pn]
+        res = [f.result() for f in fut]
+    charged, neutral = res[: len(SEEDS)], res[len(SEEDS):]
     return {"root": root, "neutral": neutral, "charged": charged, "pn": pn, "pc": pc,
             "build": build_dir}
 
 
 @pytest.mark.parametrize("case", ["neutral", "charged"])
-def test_all_deposited_none_lost(runs, case):
-    r = runs[case]
+@pytest.mark.parametrize("k", range(len(SEEDS)))
+def test_all_deposited_none_lost(runs, case, k):
+    r = runs[case][k]
     assert r["inserted"] == N            # fix deposit inserted every particle
     assert r["natoms"] == N and r["lost"] == 0
     assert r["deck"]["flying"] == 0      # all at rest (< 5 % of U_0) when the run stopped
@@ -49,8 +58,9 @@ def test_all_deposited_none_lost(runs, case):
 
 
 @pytest.mark.parametrize("case", ["neutral", "charged"])
-def test_python_analysis_matches_computes(runs, case):
-    r = runs[case]
+@pytest.mark.parametrize("k", range(len(SEEDS)))
+def test_python_analysis_matches_computes(runs, case, k):
+    r = runs[case][k]
     # same slab, exact sphere-slab volumes on both sides; positions written with 12 digits
     assert r["phi_compute"] == pytest.approx(r["phi"], abs=1e-8)
     # same geometric criterion (r_ij <= r_i + r_j); overlaps are ~1e-9 m >> dump rounding
@@ -58,20 +68,23 @@ def test_python_analysis_matches_computes(runs, case):
 
 
 def test_charged_looser_than_neutral(runs):
+    mean = lambda rs, k: statistics.fmean(r[k] for r in rs)
     n, c = runs["neutral"], runs["charged"]
-    assert c["phi"] < n["phi"]
-    assert c["Z"] < n["Z"]
+    print(f"phi neutral {[round(r['phi'], 4) for r in n]}, charged {[round(r['phi'], 4) for r in c]}")
+    print(f"<Z> neutral {[round(r['Z'], 3) for r in n]}, charged {[round(r['Z'], 3) for r in c]}")
+    assert mean(c, "phi") < mean(n, "phi")
+    assert mean(c, "Z") < mean(n, "Z")
 
 
 def test_resumable(runs):
-    again = run_deposition(runs["pn"], runs["root"], runs["build"])
-    assert again["skipped"] and again["phi"] == runs["neutral"]["phi"]
+    again = run_deposition(runs["pn"][0], runs["root"], runs["build"])
+    assert again["skipped"] and again["phi"] == runs["neutral"][0]["phi"]
 
 
 def test_figures(runs, tmp_path):
     res = []
-    for k in ("neutral", "charged"):
-        r = dict(runs[k])
+    for r in runs["neutral"] + runs["charged"]:
+        r = dict(r)
         r["dir"] = str(runs["root"] / r["key"])
         res.append(r)
     paths = figures.all_figures(res, tmp_path)
