@@ -2,3 +2,4 @@
 gc_lammps_test(test_jkr_marshall SOURCES test_jkr_marshall.cpp)
 gc_lammps_test(test_jkr_marshall_reproducible NP 1 2 SOURCES test_jkr_marshall_reproducible.cpp)
 gc_lammps_test(test_coul_fmm NP 1 2 SOURCES test_coul_fmm.cpp)
+gc_lammps_test(test_packing_computes NP 1 2 SOURCES test_packing_computes.cpp)
