@@ -22,6 +22,7 @@
 
 #include "atom.h"
 #include "comm.h"
+#include "domain.h"
 #include "error.h"
 #include "fix_neigh_history.h"
 #include "force.h"
@@ -32,6 +33,7 @@
 #include "pair.h"
 #include "update.h"
 
+#include <cmath>
 #include <cstring>
 #include <vector>
 
@@ -254,10 +256,14 @@ void ComputeCoordDist::tally_global()
   double **x = atom->x;
   int *mask = atom->mask;
   const int nlocal = atom->nlocal;
+  // heights in the box image (z periodic: an owned atom may have drifted out since reneighboring)
+  const int zper = domain->zperiodic;
+  const double lz = domain->zprd, zbox = domain->boxlo[2];
   for (int i = 0; i < nlocal; i++) {
     if (!(mask[i] & groupbit)) continue;
-    if (!zlo_null && x[i][2] < zlo) continue;
-    if (!zhi_null && x[i][2] > zhi) continue;
+    const double z = zper ? x[i][2] - lz * floor((x[i][2] - zbox) / lz) : x[i][2];
+    if (!zlo_null && z < zlo) continue;
+    if (!zhi_null && z > zhi) continue;
     const int z = static_cast<int>(coord[i]);
     local[z < zmax ? z : zmax] += 1.0;
     local[zmax + 1] += coord[i];

@@ -220,20 +220,30 @@ void ComputeRDFSlab::compute_array()
   double &nref = buf[3 * nbin + 1];
   for (int k = 0; k < 3 * nbin + 2; k++) buf[k] = 0.0;
 
+  // with z periodic, an atom's height is taken in the box image that holds the slab:
+  // shift(z) = Lz floor((z - boxlo) / Lz); a reference atom's partners are judged in the
+  // reference atom's own image (a ghost at z + Lz is no partner of a slab in the box)
+
+  const int zper = domain->zperiodic;
+  const double lz = domain->zprd, zbox = domain->boxlo[2];
+  auto shift = [&](double z) { return zper ? lz * floor((z - zbox) / lz) : 0.0; };
+  auto inslab = [&](double z) { return z >= lo && z <= hi; };
+
   if (hi > lo) {
     neighbor->build_one(list);
     const double delrinv = 1.0 / delr;
     const int newton_pair = force->newton_pair;
 
-    // ordered pairs (i, j) with r_ij < rmax: hist if both centres are in the slab,
-    // count if the reference atom is; a half list holds each pair once (per rank with
-    // newton off, where a pair with a ghost atom is counted by each owner for its own atom)
+    // ordered pairs (i, j) with r_ij < rmax: count if the reference atom is in the slab, hist if
+    // its partner is too; a half list holds each pair once (per rank with newton off, where a
+    // pair with a ghost atom is counted by each owner for its own atom)
 
     for (int ii = 0; ii < list->inum; ii++) {
       const int i = list->ilist[ii];
       if (!(mask[i] & groupbit)) continue;
       const double xtmp = x[i][0], ytmp = x[i][1], ztmp = x[i][2];
-      const bool iin = (ztmp >= lo && ztmp <= hi);
+      const double si = shift(ztmp);
+      const bool iref = inslab(ztmp - si);
       const int *jlist = list->firstneigh[i];
       const int jnum = list->numneigh[i];
       for (int jj = 0; jj < jnum; jj++) {
@@ -243,11 +253,17 @@ void ComputeRDFSlab::compute_array()
         const double r = sqrt(delx * delx + dely * dely + delz * delz);
         const int ibin = static_cast<int>(r * delrinv);
         if (ibin >= nbin) continue;
-        const bool jin = (x[j][2] >= lo && x[j][2] <= hi);
-        const bool jown = newton_pair || j < nlocal;
-        if (iin) count[ibin] += 1.0;
-        if (jin && jown) count[ibin] += 1.0;
-        if (iin && jin) hist[ibin] += jown ? 2.0 : 1.0;
+        if (iref) {
+          count[ibin] += 1.0;
+          if (inslab(x[j][2] - si)) hist[ibin] += 1.0;
+        }
+        if (newton_pair || j < nlocal) {
+          const double sj = shift(x[j][2]);
+          if (inslab(x[j][2] - sj)) {
+            count[ibin] += 1.0;
+            if (inslab(ztmp - sj)) hist[ibin] += 1.0;
+          }
+        }
       }
     }
 
@@ -256,8 +272,8 @@ void ComputeRDFSlab::compute_array()
 
     for (int i = 0; i < nlocal; i++) {
       if (!(mask[i] & groupbit)) continue;
-      const double z = x[i][2];
-      if (z < lo || z > hi) continue;
+      const double z = x[i][2] - shift(x[i][2]);
+      if (!inslab(z)) continue;
       nref += 1.0;
       for (const double d : {z - lo, hi - z}) {
         if (d >= rmax) continue;

@@ -363,6 +363,14 @@ TEST(PackingComputes, Clusters)
     auto zat = cperatom(l, id, MPI_COMM_WORLD);
     for (int i = 1; i <= 10; i++) EXPECT_EQ(zat[i], zexp[i]) << id << " atom " << i;
   }
+  // a group holding chain atoms 1 and 2: partners outside the group count (atom 2 touches 3)
+  l.cmds({"group ends id 1 2", "compute gz ends coord/dist zmax 4", "run 0"});
+  auto fg = carray(l, "gz", 5, 3);
+  EXPECT_EQ(fg[1][1], 1.0);
+  EXPECT_EQ(fg[2][1], 1.0);
+  EXPECT_DOUBLE_EQ(cscalar(l, "gz"), 1.5);
+  auto zg = cperatom(l, "gz", MPI_COMM_WORLD);
+  EXPECT_EQ(zg[4], 0.0) << "atoms outside the group get Z = 0";
   // slab z >= 5e-7: the two upper tetrahedron atoms (z = s); 2 of their 3 contacts are with
   // atoms outside the slab and count all the same
   EXPECT_EQ(cscalar(l, "geoz"), 3.0);
@@ -401,6 +409,38 @@ TEST(PackingComputes, JKRContactInTension)
     auto za = cperatom(l, "act", MPI_COMM_WORLD);
     EXPECT_EQ(za[1], st.act);
     EXPECT_EQ(za[2], st.act);
+  }
+}
+
+// A box periodic in z as well: every FCC atom has Z = 12; phi of a slab of 3 periods is the
+// bulk value also when the slab crosses the periodic z boundary (images of the spheres), and
+// the whole box gives it too; the shell counts 12, 6, 24, 12 hold for every reference atom
+// (partners through the z boundary are ghosts). Tolerances as in the open-box tests.
+TEST(PackingComputes, PeriodicZ)
+{
+  Lmp l;
+  make_lattice(l, FCC, 4, 4, 6);
+  const double a = FCC.a;
+  l.cmds({"change_box all boundary p p p", "compute z all coord/dist tolerance 1e-9",
+          fmt::format("compute phi1 all packing/slab {:.17g} {:.17g}", -0.3123 * a, 2.6877 * a),
+          fmt::format("compute phi2 all packing/slab {:.17g} {:.17g}", 4.1 * a, 7.1 * a),
+          fmt::format("compute phi3 all packing/slab 0 {:.17g}", 6 * a),
+          "compute g all rdf/slab 30 2.1 units diameter", "run 0"});
+  EXPECT_DOUBLE_EQ(cscalar(l, "z"), 12.0);
+  for (const char *id : {"phi1", "phi2", "phi3"}) EXPECT_NEAR(cscalar(l, id), FCC.phi, 1e-9) << id;
+  auto g = carray(l, "g", 30, 3);
+  EXPECT_NEAR(g[14][2], 12.0, 1e-12);    // bin of r = 1
+  EXPECT_NEAR(g[20][2], 18.0, 1e-12);    // sqrt 2
+  EXPECT_NEAR(g[24][2], 42.0, 1e-12);    // sqrt 3
+  EXPECT_NEAR(g[28][2], 54.0, 1e-12);    // 2
+  // rdf/slab needs its slab inside the periodic z range
+  l.cmd(fmt::format("compute gbad all rdf/slab 30 2.1 z -1 {:.17g}", 3 * a));
+  l.cmd("thermo_style custom step c_gbad[1][2]");
+  try {
+    l.cmd("run 0");
+    ADD_FAILURE() << "no error for a slab outside the periodic z range";
+  } catch (LAMMPS_NS::LAMMPSException &e) {
+    expect_match(e.what(), "rdf/slab slab \\[-1, .*\\] must lie inside the periodic z range");
   }
 }
 
