@@ -261,11 +261,11 @@ void ComputeCoordDist::tally_global()
   const double lz = domain->zprd, zbox = domain->boxlo[2];
   for (int i = 0; i < nlocal; i++) {
     if (!(mask[i] & groupbit)) continue;
-    const double z = zper ? x[i][2] - lz * floor((x[i][2] - zbox) / lz) : x[i][2];
-    if (!zlo_null && z < zlo) continue;
-    if (!zhi_null && z > zhi) continue;
-    const int z = static_cast<int>(coord[i]);
-    local[z < zmax ? z : zmax] += 1.0;
+    const double zi = zper ? x[i][2] - lz * floor((x[i][2] - zbox) / lz) : x[i][2];
+    if (!zlo_null && zi < zlo) continue;
+    if (!zhi_null && zi > zhi) continue;
+    const int nc = static_cast<int>(coord[i]);
+    local[nc < zmax ? nc : zmax] += 1.0;
     local[zmax + 1] += coord[i];
     local[zmax + 2] += 1.0;
   }
