@@ -6,8 +6,9 @@ Usage (from the build folder's environment, e.g. `. build-computes/env.sh`):
 
 For each compute: 'cold' = first invocation after a reneighboring (includes the build of its
 occasional neighbor list; rdf/slab's list reaches rmax, 50 bins per diameter), 'warm' = later
-invocations before the next reneighboring (the list is reused, as LAMMPS's compute rdf does). Reference: wall time of
-`run 10` (10 full MD steps) and LAMMPS's Pair time of those 10 steps. Best of --reps.
+invocations before the next reneighboring (the list is reused, as LAMMPS's compute rdf does).
+Reference: wall time of `run 10` (10 full MD steps) and LAMMPS's Pair time of those 10 steps
+(average over ranks). Best of --reps. Under mpirun, rank 0 reports.
 """
 import argparse
 import os
@@ -31,6 +32,11 @@ lmp = lammps(cmdargs=["-log", a.log, "-screen", "none", "-var", "nx", str(a.nx),
 lmp.file(os.path.join(here, "bench_computes.in"))
 lmp.command("run 0 post no")
 natoms = lmp.get_natoms()
+me = lmp.extract_setting("world_rank")
+nprocs = lmp.extract_setting("world_size")
+if me != 0:
+    print = lambda *args, **kw: None    # noqa: E731  report from rank 0 only
+print(f"{nprocs} MPI rank(s)")
 print(f"bed: {natoms} spheres, set-up {time.perf_counter() - t0:.1f} s")
 
 def pair_time_of_last_run():
@@ -80,3 +86,4 @@ for k in outputs:
     c, w = min(cold[k]), min(warm[k])
     print(f"{names[k]:<24}{c:>10.4f}{w:>10.4f}{c / r10:>12.3f}{c / p10:>12.3f}")
 lmp.close()
+lmp.finalize()

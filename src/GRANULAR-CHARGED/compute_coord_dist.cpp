@@ -80,16 +80,14 @@ ComputeCoordDist::ComputeCoordDist(LAMMPS *lmp, int narg, char **arg) :
       if (iarg + 2 > narg) utils::missing_cmd_args(FLERR, "compute coord/dist tolerance", error);
       tolerance = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
       if (tolerance < 0.0)
-        error->all(FLERR, iarg + 1, "Compute coord/dist tolerance must be >= 0, got {}",
-                   tolerance);
+        error->all(FLERR, iarg + 1, "Compute coord/dist tolerance must be >= 0, got {}", tolerance);
       tolerance_set = 1;
       iarg += 2;
     } else if (strcmp(arg[iarg], "zmax") == 0) {
       if (iarg + 2 > narg) utils::missing_cmd_args(FLERR, "compute coord/dist zmax", error);
       zmax = utils::inumeric(FLERR, arg[iarg + 1], false, lmp);
       if (zmax < 1 || zmax > 10000)
-        error->all(FLERR, iarg + 1, "Compute coord/dist zmax must be in [1, 10000], got {}",
-                   zmax);
+        error->all(FLERR, iarg + 1, "Compute coord/dist zmax must be in [1, 10000], got {}", zmax);
       iarg += 2;
     } else
       error->all(FLERR, iarg, "Unknown compute coord/dist keyword: {}", arg[iarg]);
@@ -138,8 +136,10 @@ void ComputeCoordDist::init()
     // pair->list->firstneigh[i][jj]); without history the pair style's contact test is
     // plain overlap r_ij < r_i + r_j
     if (!force->pair_match("^granular", 0) && !force->pair_match("^gran/", 0))
-      error->all(FLERR, "Compute coord/dist contact active requires a granular pair style "
-                 "(pair_style granular or gran/*), not {}", force->pair_style);
+      error->all(FLERR,
+                 "Compute coord/dist contact active requires a granular pair style "
+                 "(pair_style granular or gran/*), not {}",
+                 force->pair_style);
     auto fixes = modify->get_fix_by_style("^NEIGH_HISTORY");
     std::vector<FixNeighHistory *> hist;
     for (auto &f : fixes) {
@@ -147,16 +147,18 @@ void ComputeCoordDist::init()
       if (fh && fh->pair) hist.push_back(fh);
     }
     if (hist.size() > 1)
-      error->all(FLERR, "Compute coord/dist contact active supports one granular pair style "
-                 "with contact history, found {}", hist.size());
+      error->all(FLERR,
+                 "Compute coord/dist contact active supports one granular pair style "
+                 "with contact history, found {}",
+                 hist.size());
     if (hist.size() == 1) fix_history = hist[0];
   }
 
   // own occasional list of granular size (r_i + r_j + skin), as compute contact/atom
   if (!fix_history) {
     if (tolerance > neighbor->skin)
-      error->all(FLERR, "Compute coord/dist tolerance {} exceeds the neighbor skin {}",
-                 tolerance, neighbor->skin);
+      error->all(FLERR, "Compute coord/dist tolerance {} exceeds the neighbor skin {}", tolerance,
+                 neighbor->skin);
     neighbor->add_request(this, NeighConst::REQ_SIZE | NeighConst::REQ_OCCASIONAL);
   }
 }

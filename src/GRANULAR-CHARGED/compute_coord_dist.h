@@ -36,18 +36,18 @@ class ComputeCoordDist : public Compute {
   double memory_usage() override;
 
  private:
-  int zmax;               // largest Z with its own row of f(Z); the last row counts Z >= zmax
-  double zlo, zhi;        // slab of atom centres that enter f(Z) and <Z>
-  int zlo_null, zhi_null; // 1 if that bound is NULL (unbounded: the bed's own extent)
-  int active;             // 1: contacts held by the granular pair style, 0: geometric
-  double tolerance;       // geometric contact if r_ij <= r_i + r_j + tolerance
-  int tolerance_set;      // 1 if the tolerance keyword was given
+  int zmax;                  // largest Z with its own row of f(Z); the last row counts Z >= zmax
+  double zlo, zhi;           // slab of atom centres that enter f(Z) and <Z>
+  int zlo_null, zhi_null;    // 1 if that bound is NULL (unbounded: the bed's own extent)
+  int active;                // 1: contacts held by the granular pair style, 0: geometric
+  double tolerance;          // geometric contact if r_ij <= r_i + r_j + tolerance
+  int tolerance_set;         // 1 if the tolerance keyword was given
 
-  int nmax;                          // allocated length of coord
-  double *coord;                     // per-atom Z
-  double *tally;                     // global f(Z) counts, sum Z, number of atoms
-  bigint tally_step;                 // timestep of the last tally (-1: none)
-  class NeighList *list;             // own occasional list (geometric contacts)
+  int nmax;                              // allocated length of coord
+  double *coord;                         // per-atom Z
+  double *tally;                         // global f(Z) counts, sum Z, number of atoms
+  bigint tally_step;                     // timestep of the last tally (-1: none)
+  class NeighList *list;                 // own occasional list (geometric contacts)
   class FixNeighHistory *fix_history;    // contact flags of the pair style (active contacts)
 
   void tally_global();

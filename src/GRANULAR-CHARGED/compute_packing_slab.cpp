@@ -43,8 +43,7 @@ static inline double cap_volume(double r, double d)
 
 /* ---------------------------------------------------------------------- */
 
-ComputePackingSlab::ComputePackingSlab(LAMMPS *lmp, int narg, char **arg) :
-    Compute(lmp, narg, arg)
+ComputePackingSlab::ComputePackingSlab(LAMMPS *lmp, int narg, char **arg) : Compute(lmp, narg, arg)
 {
   if (narg < 5) utils::missing_cmd_args(FLERR, "compute packing/slab", error);
   if (!atom->radius_flag)

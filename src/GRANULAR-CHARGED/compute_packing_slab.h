@@ -31,10 +31,10 @@ class ComputePackingSlab : public Compute {
   double memory_usage() override;
 
  private:
-  double zlo, zhi;        // slab
-  int zlo_null, zhi_null; // 1 if that bound is NULL (lowest sphere bottom / highest sphere top)
-  double result[3];       // phi, # of atoms whose sphere intersects the slab, slab volume
-  bigint result_step;     // timestep of result (-1: none)
+  double zlo, zhi;           // slab
+  int zlo_null, zhi_null;    // 1 if that bound is NULL (lowest sphere bottom / highest sphere top)
+  double result[3];          // phi, # of atoms whose sphere intersects the slab, slab volume
+  bigint result_step;        // timestep of result (-1: none)
 
   void check_box();
   void tally();

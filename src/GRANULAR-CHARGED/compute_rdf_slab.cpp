@@ -65,7 +65,8 @@ ComputeRDFSlab::ComputeRDFSlab(LAMMPS *lmp, int narg, char **arg) :
   if (nbin < 1 || nbin > 1000000)
     error->all(FLERR, 3, "Compute rdf/slab number of bins must be in [1, 1000000], got {}", nbin);
   rmax_user = utils::numeric(FLERR, arg[4], false, lmp);
-  if (rmax_user <= 0.0) error->all(FLERR, 4, "Compute rdf/slab rmax must be > 0, got {}", rmax_user);
+  if (rmax_user <= 0.0)
+    error->all(FLERR, 4, "Compute rdf/slab rmax must be > 0, got {}", rmax_user);
 
   diameter_units = 0;
   zlo_null = zhi_null = 1;
@@ -152,8 +153,10 @@ void ComputeRDFSlab::init()
       }
     MPI_Allreduce(loc, all, 2, MPI_DOUBLE, MPI_SUM, world);
     if (all[1] == 0.0 || all[0] <= 0.0)
-      error->all(FLERR, "Compute rdf/slab units diameter needs atoms of non-zero size in group {} "
-                 "at the start of a run", group->names[igroup]);
+      error->all(FLERR,
+                 "Compute rdf/slab units diameter needs atoms of non-zero size in group {} "
+                 "at the start of a run",
+                 group->names[igroup]);
     dunit = all[0] / all[1];
   }
   rmax = rmax_user * dunit;
@@ -173,8 +176,10 @@ void ComputeRDFSlab::init()
   else
     cutghost = comm->cutghostuser;
   if (mycutneigh > cutghost)
-    error->all(FLERR, "Compute rdf/slab rmax plus skin {} exceeds the ghost atom range {}: use "
-               "comm_modify cutoff {} or larger", mycutneigh, cutghost, mycutneigh);
+    error->all(FLERR,
+               "Compute rdf/slab rmax plus skin {} exceeds the ghost atom range {}: use "
+               "comm_modify cutoff {} or larger",
+               mycutneigh, cutghost, mycutneigh);
 
   auto req = neighbor->add_request(this, NeighConst::REQ_OCCASIONAL);
   req->set_cutoff(mycutneigh);
@@ -226,8 +231,12 @@ void ComputeRDFSlab::compute_array()
 
   const int zper = domain->zperiodic;
   const double lz = domain->zprd, zbox = domain->boxlo[2];
-  auto shift = [&](double z) { return zper ? lz * floor((z - zbox) / lz) : 0.0; };
-  auto inslab = [&](double z) { return z >= lo && z <= hi; };
+  auto shift = [&](double z) {
+    return zper ? lz * floor((z - zbox) / lz) : 0.0;
+  };
+  auto inslab = [&](double z) {
+    return z >= lo && z <= hi;
+  };
 
   if (hi > lo) {
     neighbor->build_one(list);

@@ -33,16 +33,17 @@ class ComputeRDFSlab : public Compute {
   double memory_usage() override;
 
  private:
-  int nbin;               // # of rdf bins
-  double rmax_user;       // rmax as given (box units or diameters)
-  int diameter_units;     // 1 if r and rmax are in units of the mean particle diameter
-  double zlo, zhi;        // slab of atom centres
-  int zlo_null, zhi_null; // 1 if that bound is NULL (lowest / highest centre of the group)
+  int nbin;                  // # of rdf bins
+  double rmax_user;          // rmax as given (box units or diameters)
+  int diameter_units;        // 1 if r and rmax are in units of the mean particle diameter
+  double zlo, zhi;           // slab of atom centres
+  int zlo_null, zhi_null;    // 1 if that bound is NULL (lowest / highest centre of the group)
 
-  double dunit;           // length unit of r: 1 or the mean diameter at init()
-  double rmax, delr;      // rmax and bin width in box units
-  double *buf, *bufall;   // local and global tallies: hist[nbin], count[nbin], capsum[nbin+1], nref
-  class NeighList *list;  // occasional half list with cutoff rmax + skin
+  double dunit;         // length unit of r: 1 or the mean diameter at init()
+  double rmax, delr;    // rmax and bin width in box units
+  double *buf,
+      *bufall;    // local and global tallies: hist[nbin], count[nbin], capsum[nbin+1], nref
+  class NeighList *list;    // occasional half list with cutoff rmax + skin
 
   void check_box();
 };

@@ -92,15 +92,15 @@ void expect_match(const std::string &msg, const std::string &re)
 // ---- lattices of touching spheres, d = 1 (units metal: the lattice scale is the cell edge) ----
 struct Lattice {
   std::string style;
-  double a;           // cubic cell edge for touching spheres of diameter 1
-  double layer;       // spacing of the (001) layers
-  int per_layer;      // atoms per layer and cell
-  int Z;              // coordination number
-  double phi;         // volume fraction
+  double a;         // cubic cell edge for touching spheres of diameter 1
+  double layer;     // spacing of the (001) layers
+  int per_layer;    // atoms per layer and cell
+  int Z;            // coordination number
+  double phi;       // volume fraction
 };
 const double SQ2 = std::sqrt(2.0), SQ3 = std::sqrt(3.0);
 const Lattice FCC{"fcc", SQ2, SQ2 / 2, 2, 12, M_PI / (3 * SQ2)};
-const Lattice BCC{"bcc", 2 / SQ3, 1 / SQ3, 1, 8, M_PI * SQ3 / 8};
+const Lattice BCC{"bcc", 2 / SQ3, 1 / SQ3, 1, 8, M_PI *SQ3 / 8};
 const Lattice SC{"sc", 1.0, 1.0, 1, 6, M_PI / 6};
 
 constexpr int NX = 4, NY = 4, NZ = 8;
@@ -147,7 +147,8 @@ TEST(PackingComputes, LatticeCoordination)
     for (auto &h : heights) {
       const double zlo = h[0] * lat.a, zhi = h[1] * lat.a;
       ASSERT_TRUE(zlo > 0.0 && zhi < top) << "the slab must exclude the free faces";
-      l.cmd(fmt::format("compute z{} all coord/dist z {:.17g} {:.17g} tolerance 1e-9", n, zlo, zhi));
+      l.cmd(
+          fmt::format("compute z{} all coord/dist z {:.17g} {:.17g} tolerance 1e-9", n, zlo, zhi));
       ++n;
     }
     l.cmd("compute zall all coord/dist tolerance 1e-9");
@@ -176,7 +177,8 @@ TEST(PackingComputes, LatticeCoordination)
         EXPECT_LT(zat[i], lat.Z) << lat.style << " face atom " << i;
     }
     EXPECT_EQ(interior, (nlayers - 2) * lat.per_layer * NX * NY);
-    if (lat.style == "fcc") EXPECT_NEAR(cscalar(l, "zall"), (2 * 8.0 + (2 * NZ - 2) * 12.0) / (2 * NZ), 1e-12);
+    if (lat.style == "fcc")
+      EXPECT_NEAR(cscalar(l, "zall"), (2 * 8.0 + (2 * NZ - 2) * 12.0) / (2 * NZ), 1e-12);
   }
 }
 
@@ -202,7 +204,8 @@ TEST(PackingComputes, LatticePackingFraction)
       auto v = cvector(l, id, 3);
       EXPECT_NEAR(v[0], lat.phi, 1e-9);
       // spheres reaching into the slab: centres within r = 0.5 of it
-      EXPECT_EQ(v[1], atoms_in(lat, z0[k] * lat.a - 0.5 + 1e-12, (z0[k] + 3) * lat.a + 0.5 - 1e-12));
+      EXPECT_EQ(v[1],
+                atoms_in(lat, z0[k] * lat.a - 0.5 + 1e-12, (z0[k] + 3) * lat.a + 0.5 - 1e-12));
       EXPECT_NEAR(v[2], area * 3 * lat.a, 1e-12 * area * 3 * lat.a);
     }
     const double natoms = l.lmp->atom->natoms;
@@ -400,8 +403,8 @@ TEST(PackingComputes, JKRContactInTension)
     double gap;
     double geo, act;
   };
-  const Step steps[] = {{-1e-9, 1, 1}, {0.5 * dC, 0, 1}, {0.9 * dC, 0, 1}, {1.5 * dC, 0, 0},
-                        {0.5 * dC, 0, 0}, {-1e-9, 1, 1}};
+  const Step steps[] = {{-1e-9, 1, 1},    {0.5 * dC, 0, 1}, {0.9 * dC, 0, 1},
+                        {1.5 * dC, 0, 0}, {0.5 * dC, 0, 0}, {-1e-9, 1, 1}};
   for (auto &st : steps) {
     place(st.gap);
     EXPECT_EQ(cscalar(l, "geo"), st.geo) << "gap " << st.gap / dC << " delta_C";
@@ -444,6 +447,36 @@ TEST(PackingComputes, PeriodicZ)
   }
 }
 
+// pair hybrid: "active" reads the granular sub-style's contact flags; a pair handled by another
+// sub-style (zero) is a geometric contact but never an active one. Pair 1-2 (granular) is pulled
+// to a gap of 0.5 delta_C (still held), pair 3-4 (zero) overlaps by 1 nm throughout.
+TEST(PackingComputes, ActiveUnderPairHybrid)
+{
+  Lmp l;
+  l.cmds({"units si", "atom_style sphere", "atom_modify map array", "boundary f f f",
+          "comm_modify vel yes", "region box block -1e-5 1e-5 -1e-5 1e-5 -1e-5 1e-5",
+          "create_box 2 box"});
+  atom_at(l, -RP + 0.5e-9, 0, 0);
+  atom_at(l, RP - 0.5e-9, 0, 0);
+  l.cmds({"create_atoms 2 single 0 5e-6 0", "create_atoms 2 single 1.999e-6 5e-6 0",
+          "set type * diameter 2e-6", "set type * density 2500",
+          "pair_style hybrid granular zero 4e-6",
+          "pair_coeff * * granular jkr/marshall 2e8 0.7 0.33 0.01 damping marshall tangential "
+          "marshall 0.3",
+          "pair_coeff 2 2 zero", "neighbor 2e-7 bin", "thermo_style custom step atoms",
+          "compute geo all coord/dist", "compute act all coord/dist contact active", "run 0"});
+  auto za = cperatom(l, "act", MPI_COMM_WORLD), zg = cperatom(l, "geo", MPI_COMM_WORLD);
+  EXPECT_EQ(za, (std::vector<double>{0, 1, 1, 0, 0}));
+  EXPECT_EQ(zg, (std::vector<double>{0, 1, 1, 1, 1}));
+  const double gap = 0.5 * jkr.deltaC();
+  l.cmds({fmt::format("set atom 1 x {:.17g}", -RP - gap / 2),
+          fmt::format("set atom 2 x {:.17g}", RP + gap / 2), "run 0"});
+  za = cperatom(l, "act", MPI_COMM_WORLD);
+  zg = cperatom(l, "geo", MPI_COMM_WORLD);
+  EXPECT_EQ(za, (std::vector<double>{0, 1, 1, 0, 0}));
+  EXPECT_EQ(zg, (std::vector<double>{0, 0, 0, 1, 1}));
+}
+
 // Without contact history (hooke, no tangential history) "active" is the pair style's overlap
 // test r < r_i + r_j; touching lattice spheres (r = d up to round-off) are not in contact, while
 // a 1e-6 d compression makes all of them so.
@@ -453,8 +486,8 @@ TEST(PackingComputes, ActiveWithoutHistory)
   l.cmds({"units metal", "atom_style sphere", "boundary p p p", "lattice sc 1.0",
           "region box block 0 4 0 4 0 4", "create_box 1 box", "create_atoms 1 box",
           "set type 1 diameter 1.000001", "pair_style granular",
-          "pair_coeff * * hooke 1000 0.5 tangential linear_nohistory 1 0.3",
-          "comm_modify vel yes", "compute act all coord/dist contact active", "run 0"});
+          "pair_coeff * * hooke 1000 0.5 tangential linear_nohistory 1 0.3", "comm_modify vel yes",
+          "compute act all coord/dist contact active", "run 0"});
   EXPECT_EQ(cscalar(l, "act"), 6.0);
 }
 
@@ -471,7 +504,8 @@ TEST(PackingComputes, OneVersusTwoRanks)
   auto run = [](MPI_Comm comm, const std::string &newton, std::vector<double> &out) {
     Lmp l(comm);
     make_lattice(l, FCC, 4, 4, 6, newton);
-    l.cmds({"change_box all boundary p p m", "displace_atoms all random 0.02 0.02 0.02 8675309 units box",
+    l.cmds({"change_box all boundary p p m",
+            "displace_atoms all random 0.02 0.02 0.02 8675309 units box",
             "compute z all coord/dist z 1.0 6.0 tolerance 0.01",
             "compute g all rdf/slab 40 2.0 z 1.5 5.5 units diameter",
             "compute phi all packing/slab 1.1 6.3", "run 0"});
@@ -528,21 +562,27 @@ TEST(PackingComputes, BadInput)
                  "rdf/slab requires a box periodic in x and y");
     expect_match(err(box, "compute c all packing/slab 1 2"),
                  "packing/slab requires a box periodic in x and y");
-    EXPECT_EQ(err(box, "compute c all coord/dist z 1 2"), "no error") << "coord/dist needs no periodicity";
+    EXPECT_EQ(err(box, "compute c all coord/dist z 1 2"), "no error")
+        << "coord/dist needs no periodicity";
   }
   // zlo >= zhi
-  expect_match(err(sphere, "compute c all coord/dist z 2 1"), "coord/dist z: zlo 2 must be < zhi 1");
+  expect_match(err(sphere, "compute c all coord/dist z 2 1"),
+               "coord/dist z: zlo 2 must be < zhi 1");
   expect_match(err(sphere, "compute c all coord/dist z 1.5 1.5"), "zlo 1.5 must be < zhi 1.5");
-  expect_match(err(sphere, "compute c all rdf/slab 10 2 z 3 1"), "rdf/slab z: zlo 3 must be < zhi 1");
+  expect_match(err(sphere, "compute c all rdf/slab 10 2 z 3 1"),
+               "rdf/slab z: zlo 3 must be < zhi 1");
   expect_match(err(sphere, "compute c all packing/slab 2 2"), "packing/slab zlo 2 must be < zhi 2");
   // bad counts and values
-  expect_match(err(sphere, "compute c all rdf/slab 0 2"), "number of bins must be in \\[1, 1000000\\], got 0");
+  expect_match(err(sphere, "compute c all rdf/slab 0 2"),
+               "number of bins must be in \\[1, 1000000\\], got 0");
   expect_match(err(sphere, "compute c all rdf/slab -5 2"), "number of bins.*got -5");
   expect_match(err(sphere, "compute c all rdf/slab 10 0"), "rdf/slab rmax must be > 0, got 0");
   expect_match(err(sphere, "compute c all rdf/slab 10 -1.5"), "rmax must be > 0, got -1.5");
   expect_match(err(sphere, "compute c all rdf/slab 2.5 2"), "Expected integer.*2.5");
-  expect_match(err(sphere, "compute c all coord/dist zmax 0"), "zmax must be in \\[1, 10000\\], got 0");
-  expect_match(err(sphere, "compute c all coord/dist tolerance -1e-3"), "tolerance must be >= 0, got -0.001");
+  expect_match(err(sphere, "compute c all coord/dist zmax 0"),
+               "zmax must be in \\[1, 10000\\], got 0");
+  expect_match(err(sphere, "compute c all coord/dist tolerance -1e-3"),
+               "tolerance must be >= 0, got -0.001");
   expect_match(err(sphere, "compute c all coord/dist contact touching"),
                "contact must be 'geometric' or 'active', got 'touching'");
   expect_match(err(sphere, "compute c all coord/dist contact active tolerance 0.1"),
@@ -550,21 +590,26 @@ TEST(PackingComputes, BadInput)
   expect_match(err(sphere, "compute c all rdf/slab 10 2 units sigma"),
                "units must be 'box' or 'diameter', got 'sigma'");
   // unknown keywords and missing arguments
-  expect_match(err(sphere, "compute c all coord/dist zz 1 2"), "Unknown compute coord/dist keyword: zz");
-  expect_match(err(sphere, "compute c all rdf/slab 10 2 cutoff 3"), "Unknown compute rdf/slab keyword: cutoff");
-  expect_match(err(sphere, "compute c all packing/slab 1 2 every"), "Unknown compute packing/slab keyword: every");
-  expect_match(err(sphere, "compute c all rdf/slab 10"), "Illegal compute rdf/slab.*missing argument");
-  expect_match(err(sphere, "compute c all packing/slab 1"), "Illegal compute packing/slab.*missing argument");
+  expect_match(err(sphere, "compute c all coord/dist zz 1 2"),
+               "Unknown compute coord/dist keyword: zz");
+  expect_match(err(sphere, "compute c all rdf/slab 10 2 cutoff 3"),
+               "Unknown compute rdf/slab keyword: cutoff");
+  expect_match(err(sphere, "compute c all packing/slab 1 2 every"),
+               "Unknown compute packing/slab keyword: every");
+  expect_match(err(sphere, "compute c all rdf/slab 10"),
+               "Illegal compute rdf/slab.*missing argument");
+  expect_match(err(sphere, "compute c all packing/slab 1"),
+               "Illegal compute packing/slab.*missing argument");
   expect_match(err(sphere, "compute c all coord/dist z 1"), "coord/dist z.*missing argument");
   // run-time checks
-  const std::vector<std::string> gran = {"create_atoms 1 single 1 1 1", "set type 1 diameter 1",
-                                         "pair_style granular",
-                                         "pair_coeff * * hooke 1000 0.5 tangential linear_nohistory 1 0.3",
-                                         "comm_modify vel yes"};
+  const std::vector<std::string> gran = {
+      "create_atoms 1 single 1 1 1", "set type 1 diameter 1", "pair_style granular",
+      "pair_coeff * * hooke 1000 0.5 tangential linear_nohistory 1 0.3", "comm_modify vel yes"};
   auto c = with(gran);
   c.push_back("compute c all rdf/slab 10 4");
   c.push_back("thermo_style custom step c_c[1][2]");
-  expect_match(err(c, "run 0"), "rdf/slab rmax plus skin 4.3 exceeds the ghost atom range .*comm_modify cutoff");
+  expect_match(err(c, "run 0"),
+               "rdf/slab rmax plus skin 4.3 exceeds the ghost atom range .*comm_modify cutoff");
   c = with({"create_atoms 1 single 1 1 1", "set type 1 diameter 1", "pair_style zero 1.0",
             "pair_coeff * *", "compute c all coord/dist contact active"});
   expect_match(err(c, "run 0"), "contact active requires a granular pair style.*not zero");
