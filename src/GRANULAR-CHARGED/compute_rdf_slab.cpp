@@ -202,29 +202,6 @@ void ComputeRDFSlab::compute_array()
   int *mask = atom->mask;
   const int nlocal = atom->nlocal;
 
-  // slab: NULL bounds are the lowest / highest centre of the group
-
-  double lo = zlo, hi = zhi;
-  if (zlo_null || zhi_null) {
-    double ext[2] = {-BIG, -BIG}, extall[2];
-    for (int i = 0; i < nlocal; i++)
-      if (mask[i] & groupbit) {
-        ext[0] = MAX(ext[0], -x[i][2]);
-        ext[1] = MAX(ext[1], x[i][2]);
-      }
-    MPI_Allreduce(ext, extall, 2, MPI_DOUBLE, MPI_MAX, world);
-    if (zlo_null) lo = -extall[0];
-    if (zhi_null) hi = extall[1];
-  }
-  if (domain->zperiodic && (lo < domain->boxlo[2] || hi > domain->boxhi[2]))
-    error->all(FLERR, Error::NOLASTLINE,
-               "Compute rdf/slab slab [{}, {}] must lie inside the periodic z range [{}, {}]", lo,
-               hi, domain->boxlo[2], domain->boxhi[2]);
-
-  double *hist = buf, *count = buf + nbin, *capsum = buf + 2 * nbin;
-  double &nref = buf[3 * nbin + 1];
-  for (int k = 0; k < 3 * nbin + 2; k++) buf[k] = 0.0;
-
   // with z periodic, an atom's height is taken in the box image that holds the slab:
   // shift(z) = Lz floor((z - boxlo) / Lz); a reference atom's partners are judged in the
   // reference atom's own image (a ghost at z + Lz is no partner of a slab in the box)
@@ -234,9 +211,33 @@ void ComputeRDFSlab::compute_array()
   auto shift = [&](double z) {
     return zper ? lz * floor((z - zbox) / lz) : 0.0;
   };
+
+  // slab: NULL bounds are the lowest / highest (wrapped) centre of the group
+
+  double lo = zlo, hi = zhi;
+  if (zlo_null || zhi_null) {
+    double ext[2] = {-BIG, -BIG}, extall[2];
+    for (int i = 0; i < nlocal; i++)
+      if (mask[i] & groupbit) {
+        const double z = x[i][2] - shift(x[i][2]);
+        ext[0] = MAX(ext[0], -z);
+        ext[1] = MAX(ext[1], z);
+      }
+    MPI_Allreduce(ext, extall, 2, MPI_DOUBLE, MPI_MAX, world);
+    if (zlo_null) lo = -extall[0];
+    if (zhi_null) hi = extall[1];
+  }
+  if (zper && (lo < domain->boxlo[2] || hi > domain->boxhi[2]))
+    error->all(FLERR, Error::NOLASTLINE,
+               "Compute rdf/slab slab [{}, {}] must lie inside the periodic z range [{}, {}]", lo,
+               hi, domain->boxlo[2], domain->boxhi[2]);
   auto inslab = [&](double z) {
     return z >= lo && z <= hi;
   };
+
+  double *hist = buf, *count = buf + nbin, *capsum = buf + 2 * nbin;
+  double &nref = buf[3 * nbin + 1];
+  for (int k = 0; k < 3 * nbin + 2; k++) buf[k] = 0.0;
 
   if (hi > lo) {
     neighbor->build_one(list);
