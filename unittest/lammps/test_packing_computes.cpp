@@ -247,18 +247,22 @@ TEST(PackingComputes, LatticeRDF)
   for (int k = 0; k < 30; k++) EXPECT_NEAR(gb[k][0], g[k][0], 1e-12);
 }
 
-// Ideal gas filling a slab (N random points, z in [0, H], H = 4, rmax = 3 > H/2): with the
-// slab-truncated shell volumes g(r) = 1 in expectation at every r. Tolerance per bin: 5 sigma
-// with sigma = sqrt(2 / n_k), n_k the ordered-pair count of the bin (unordered pairs are
-// Poisson, each counted twice), taken from the cumulative column. Without truncation g would be
-// the mean shell fraction inside the slab, 0.64 at r = 2.9 (closed form below: a spherical
-// zone's area is proportional to its height), i.e. hundreds of sigma off.
+// Ideal gas (random points, number density 5, box 20 x 20 periodic in x, y): with the
+// slab-truncated shell volumes g(r) = 1 in expectation at every r < rmax = 3, for
+//   0: the gas filling the slab [0, 4] (H = 4 < 2 rmax: most shells cut by both faces),
+//   1: a slab [3, 7] selected inside a gas [0, 10] (partners outside the slab ignored),
+//   2: a thin slab [4.5, 5.5] inside a gas [0, 10]: every reference atom is within 0.5 of a face.
+// Tolerance per bin: 5 sigma, sigma = sqrt(2 / m_k), m_k the expected number of ordered in-slab
+// pairs of the bin (unordered pairs are Poisson, each counted twice). m_k comes from column 3
+// (all partners, n_k): m_k = n_k for variant 0, n_k f(r_k, H) for 1 and 2, where the shells lie
+// inside the gas and f(r, H) is the mean fraction of a sphere's surface inside a slab of
+// thickness H (closed form: a spherical zone's area is proportional to its height). Without
+// the truncation, g would be f: 0.64 (H = 4) and 0.17 (H = 1) at r = 2.9, hundreds of sigma off.
 TEST(PackingComputes, IdealGasSlab)
 {
-  const double H = 4.0, L = 20.0, RMAX = 3.0;
-  const int N = 8000, NBIN = 15;
-  // mean fraction of a sphere of radius r inside [0, H] for a centre uniform in [0, H]
-  auto shell_fraction = [&](double r) {
+  const double L = 20.0, RMAX = 3.0, RHO = 5.0;
+  const int NBIN = 15;
+  auto shell_fraction = [](double r, double H) {
     double s = 0.0;
     const int M = 20000;
     for (int m = 0; m < M; m++) {
@@ -267,47 +271,41 @@ TEST(PackingComputes, IdealGasSlab)
     }
     return s / M;
   };
-  EXPECT_LT(shell_fraction(2.9), 0.7) << "the test must discriminate the normalisation";
+  EXPECT_NEAR(shell_fraction(2.9, 4.0), 0.64, 0.01) << "the test must discriminate";
+  EXPECT_NEAR(shell_fraction(2.9, 1.0), 0.17, 0.01) << "the test must discriminate";
 
-  for (int variant = 0; variant < 2; variant++) {
+  struct Variant {
+    double gas, zlo, zhi;
+  };
+  for (const Variant &v :
+       {Variant{4.0, 0.0, 4.0}, Variant{10.0, 3.0, 7.0}, Variant{10.0, 4.5, 5.5}}) {
     Lmp l;
-    // variant 0: the gas is the slab; variant 1: a thicker gas, slab [3, 7] selected inside it
-    const double gz = variant == 0 ? H : 10.0, zlo = variant == 0 ? 0.0 : 3.0;
-    const int n = variant == 0 ? N : N * 10 / 4;
+    const int n = (int) std::lround(RHO * L * L * v.gas);
     l.cmds({"units lj", "atom_style sphere", "atom_modify map array", "boundary p p f",
-            fmt::format("region box block 0 {} 0 {} 0 {}", L, L, gz), "create_box 1 box",
+            fmt::format("region box block 0 {} 0 {} 0 {}", L, L, v.gas), "create_box 1 box",
             fmt::format("create_atoms 1 random {} 4711 NULL", n), "comm_modify cutoff 3.5",
             "neighbor 0.3 bin", "thermo_style custom step atoms",
-            fmt::format("compute g all rdf/slab {} {} z {} {}", NBIN, RMAX, zlo, zlo + H),
+            fmt::format("compute g all rdf/slab {} {} z {} {}", NBIN, RMAX, v.zlo, v.zhi),
             "run 0"});
     auto g = carray(l, "g", NBIN, 3);
     double nref = 0;
     for (int i = 1; i <= n; i++) {
       const double z = l.var(fmt::format("z[{}]", i));
-      if (z >= zlo && z <= zlo + H) nref += 1;
+      if (z >= v.zlo && z <= v.zhi) nref += 1;
     }
-    double prev = 0.0;
+    const bool filled = (v.zlo == 0.0 && v.zhi == v.gas);
+    double prev = 0.0, outer = 0.0;
     for (int k = 0; k < NBIN; k++) {
-      const double nk = (g[k][2] - prev) * nref;    // gas fills the slab: every partner counted
+      const double nk = (g[k][2] - prev) * nref;
       prev = g[k][2];
-      if (variant == 0) {
-        ASSERT_GT(nk, 100) << "bin " << k;
-        EXPECT_NEAR(g[k][1], 1.0, 5.0 * std::sqrt(2.0 / nk)) << "bin " << k << " r = " << g[k][0];
-      }
+      const double mk = filled ? nk : nk * shell_fraction(g[k][0], v.zhi - v.zlo);
+      ASSERT_GT(mk, 100) << "bin " << k;
+      EXPECT_NEAR(g[k][1], 1.0, 5.0 * std::sqrt(2.0 / mk))
+          << "slab [" << v.zlo << ", " << v.zhi << "] bin " << k << " r = " << g[k][0];
+      if (k >= NBIN / 2) outer += g[k][1] / (NBIN - NBIN / 2);
     }
-    if (variant == 1) {
-      // column 3 also counts partners outside the slab, so n_k over-counts the in-slab pairs
-      // by at most 1 / (shell fraction) <= 2: sigma <= sqrt(4 / n_k)
-      prev = 0.0;
-      for (int k = 0; k < NBIN; k++) {
-        const double nk = (g[k][2] - prev) * nref;
-        prev = g[k][2];
-        EXPECT_NEAR(g[k][1], 1.0, 5.0 * std::sqrt(4.0 / nk)) << "bin " << k;
-      }
-      double s = 0;
-      for (int k = NBIN / 2; k < NBIN; k++) s += g[k][1];
-      EXPECT_NEAR(s / (NBIN - NBIN / 2), 1.0, 0.01);
-    }
+    // the outer bins together: sigma < 0.5 %
+    EXPECT_NEAR(outer, 1.0, 0.02) << "slab [" << v.zlo << ", " << v.zhi << "]";
   }
 }
 
