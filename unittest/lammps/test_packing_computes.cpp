@@ -311,18 +311,20 @@ TEST(PackingComputes, IdealGasSlab)
 
 // Hand-built clusters with a small overlap (1 nm = 0.25 delta_C): a chain of 3, a triangle and a
 // tetrahedron. Z = (1,2,1), (2,2,2), (3,3,3,3): f(1) = 2, f(2) = 4, f(3) = 4, <Z> = 2.2, for
-// both contact definitions (counts are integers: exact).
+// both contact definitions (counts are integers: exact); newton on and off.
 namespace {
 constexpr double RP = 1.0e-6, EMOD = 2.0e8, NU = 0.33, GAMMA = 0.01;
 const std::string JKR_COEFF = "pair_coeff * * jkr/marshall 2e8 0.7 0.33 0.01 damping marshall "
                               "tangential marshall 0.3";
 const JKR jkr{RP / 2, EMOD / (2.0 * (1.0 - NU * NU)), GAMMA};
 
-void jkr_box(Lmp &l)
+// ranks side by side along x (processors * 1 1): the clusters below straddle x = 0, so with
+// 2 ranks their contacts cross the subdomain boundary (ghost atoms, reverse communication)
+void jkr_box(Lmp &l, const std::string &newton = "on")
 {
   l.cmds({"units si", "atom_style sphere", "atom_modify map array", "boundary f f f",
-          "comm_modify vel yes", "region box block -1e-5 1e-5 -1e-5 1e-5 -1e-5 1e-5",
-          "create_box 1 box"});
+          "newton " + newton, "processors * 1 1", "comm_modify vel yes",
+          "region box block -1e-5 1e-5 -1e-5 1e-5 -1e-5 1e-5", "create_box 1 box"});
 }
 void jkr_pair(Lmp &l)
 {
@@ -333,12 +335,11 @@ void atom_at(Lmp &l, double x, double y, double z)
 {
   l.cmd(fmt::format("create_atoms 1 single {:.17g} {:.17g} {:.17g}", x, y, z));
 }
-}    // namespace
 
-TEST(PackingComputes, Clusters)
+void clusters(const std::string &newton)
 {
   Lmp l;
-  jkr_box(l);
+  jkr_box(l, newton);
   const double D = 2 * RP - 1e-9;
   // chain along x, straddling x = 0 (2 ranks: across the subdomain boundary)
   for (int k = -1; k <= 1; k++) atom_at(l, k * D, -5e-6, 1e-7);
@@ -377,39 +378,52 @@ TEST(PackingComputes, Clusters)
   EXPECT_EQ(cscalar(l, "geoz"), 3.0);
   EXPECT_EQ(carray(l, "geoz", 21, 3)[3][1], 2.0);
 }
+}    // namespace
+
+TEST(PackingComputes, Clusters)
+{
+  for (const std::string newton : {"on", "off"}) {
+    SCOPED_TRACE("newton " + newton);
+    clusters(newton);
+  }
+}
 
 // A JKR contact in tension: approach to 1 nm overlap, then pull apart. At a gap of 0.5 delta_C
 // (delta_C = 4.04 nm) the contact is still held by pair granular (jkr/marshall breaks at
 // -delta_C) but has no geometric overlap; at 1.5 delta_C it is broken, and moving back to
-// 0.5 delta_C does not restore it (no snap-in without touching). The pair straddles x = 0.
+// 0.5 delta_C does not restore it (no snap-in without touching). The pair straddles x = 0;
+// newton on and off.
 TEST(PackingComputes, JKRContactInTension)
 {
   const double dC = jkr.deltaC();
   EXPECT_NEAR(dC, 4.04e-9, 0.01e-9);
-  Lmp l;
-  jkr_box(l);
-  atom_at(l, -RP + 0.5e-9, 0, 0);
-  atom_at(l, RP - 0.5e-9, 0, 0);
-  jkr_pair(l);
-  l.cmds({"compute geo all coord/dist", "compute act all coord/dist contact active"});
-  auto place = [&](double gap) {
-    l.cmd(fmt::format("set atom 1 x {:.17g}", -RP - gap / 2));
-    l.cmd(fmt::format("set atom 2 x {:.17g}", RP + gap / 2));
-    l.cmd("run 0");
-  };
-  struct Step {
-    double gap;
-    double geo, act;
-  };
-  const Step steps[] = {{-1e-9, 1, 1},    {0.5 * dC, 0, 1}, {0.9 * dC, 0, 1},
-                        {1.5 * dC, 0, 0}, {0.5 * dC, 0, 0}, {-1e-9, 1, 1}};
-  for (auto &st : steps) {
-    place(st.gap);
-    EXPECT_EQ(cscalar(l, "geo"), st.geo) << "gap " << st.gap / dC << " delta_C";
-    EXPECT_EQ(cscalar(l, "act"), st.act) << "gap " << st.gap / dC << " delta_C";
-    auto za = cperatom(l, "act", MPI_COMM_WORLD);
-    EXPECT_EQ(za[1], st.act);
-    EXPECT_EQ(za[2], st.act);
+  for (const std::string newton : {"on", "off"}) {
+    SCOPED_TRACE("newton " + newton);
+    Lmp l;
+    jkr_box(l, newton);
+    atom_at(l, -RP + 0.5e-9, 0, 0);
+    atom_at(l, RP - 0.5e-9, 0, 0);
+    jkr_pair(l);
+    l.cmds({"compute geo all coord/dist", "compute act all coord/dist contact active"});
+    auto place = [&](double gap) {
+      l.cmd(fmt::format("set atom 1 x {:.17g}", -RP - gap / 2));
+      l.cmd(fmt::format("set atom 2 x {:.17g}", RP + gap / 2));
+      l.cmd("run 0");
+    };
+    struct Step {
+      double gap;
+      double geo, act;
+    };
+    const Step steps[] = {{-1e-9, 1, 1},    {0.5 * dC, 0, 1}, {0.9 * dC, 0, 1},
+                          {1.5 * dC, 0, 0}, {0.5 * dC, 0, 0}, {-1e-9, 1, 1}};
+    for (auto &st : steps) {
+      place(st.gap);
+      EXPECT_EQ(cscalar(l, "geo"), st.geo) << "gap " << st.gap / dC << " delta_C";
+      EXPECT_EQ(cscalar(l, "act"), st.act) << "gap " << st.gap / dC << " delta_C";
+      auto za = cperatom(l, "act", MPI_COMM_WORLD);
+      EXPECT_EQ(za[1], st.act);
+      EXPECT_EQ(za[2], st.act);
+    }
   }
 }
 
