@@ -11,6 +11,7 @@ quarter of the particles. Prints a table and writes the figures into one folder.
 from __future__ import annotations
 
 import argparse
+import statistics
 import sys
 import time
 from pathlib import Path
@@ -31,7 +32,8 @@ def main(argv=None):
     ap.add_argument("--out", default=str(SOURCE_DIR / "demo-output"))
     ap.add_argument("--N", type=int, default=500)
     ap.add_argument("--q", type=float, nargs="+", default=[0.0, 260.0, 400.0])
-    ap.add_argument("--seed", type=int, default=4711)
+    ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
+    ap.add_argument("--jobs", type=int, default=2, help="runs at a time (default 2: both cores)")
     ap.add_argument("--np", type=int, default=1)
     a = ap.parse_args(argv)
     t0 = time.monotonic()
@@ -47,31 +49,45 @@ def main(argv=None):
     print("GRANULAR-CHARGED demo: a REDUCED version of the paper's Fig. 2 study")
     print(f"  r_p = 2 um, U0 = 1 m/s, gamma = 10 mJ/m^2, q = {', '.join(f'{q:g}' for q in a.q)} e0;"
           f" N = {a.N} in L = {DEMO_VARS['L_rp']} r_p (paper: N = 2000 in L = 28 r_p, same"
-          " particles per floor area), H = 160 r_p, one seed per case")
+          " particles per floor area), H = 160 r_p,"
+          f" seeds {', '.join(map(str, a.seeds))}, {a.jobs} runs at a time")
     if not have_fmm:
         print("  fix coul/fmm is NOT in this build: only the neutral case runs; the charged cases"
               " need fix coul/fmm (they are not faked)")
     qs = a.q if have_fmm else [q for q in a.q if q == 0]
     extra = dict(DEMO_VARS)
-    params = [DepositionParams(q=q, N=a.N, seed=a.seed, extra=dict(extra)) for q in qs]
-    res = run_sweep(params, runs, build, a.np, tracer=a.N // 2)
+    params = [DepositionParams(q=q, N=a.N, seed=s, extra=dict(extra)) for q in qs for s in a.seeds]
+    first = a.seeds[0]
+    res = run_sweep(params, runs, build, a.np, jobs=a.jobs,
+                    tracer=lambda p: a.N // 2 if p.seed == first else 0)
     # figures from these runs only
     keys = {p.key() for p in params}
     results = [r for r in load_results(runs) if r["key"] in keys]
     figdir = out
     paths = figures.all_figures(results, figdir)
     print()
-    print(f"{'q/e0':>6} {'phi':>7} {'<Z>':>6} {'Ad':>6} {'E*':>6} {'Ad*':>7} {'N':>5} {'lost':>4} "
-          f"{'wall/s':>7}")
-    for r in sorted(results, key=lambda r: r["params"]["q"]):
-        g = r["groups"]
-        print(f"{r['params']['q']:6g} {r['phi']:7.4f} {r['Z']:6.3f} {g['Ad']:6.2f} {g['Estar']:6.3f} "
-              f"{g['Adstar']:7.3f} {r['natoms']:5d} {r['lost']:4d} {r.get('wall_s', float('nan')):7.1f}")
+    print(f"{'q/e0':>6} {'runs':>4} {'phi':>7} {'+-sd':>6} {'<Z>':>6} {'+-sd':>6} {'Ad':>6} {'E*':>6} "
+          f"{'Ad*':>7} {'N':>5} {'lost':>4} {'wall/s':>7}")
+    for q in sorted({r["params"]["q"] for r in results}):
+        rs = [r for r in results if r["params"]["q"] == q]
+        g = rs[0]["groups"]
+        phi = [r["phi"] for r in rs]
+        Z = [r["Z"] for r in rs]
+        sd = lambda v: statistics.stdev(v) if len(v) > 1 else float("nan")
+        print(f"{q:6g} {len(rs):4d} {statistics.fmean(phi):7.4f} {sd(phi):6.4f} "
+              f"{statistics.fmean(Z):6.3f} {sd(Z):6.3f} {g['Ad']:6.2f} {g['Estar']:6.3f} "
+              f"{g['Adstar']:7.3f} {rs[0]['natoms']:5d} {sum(r['lost'] for r in rs):4d} "
+              f"{statistics.fmean(r.get('wall_s') or 0 for r in rs):7.1f}")
+    q0 = [r["phi"] for r in results if r["params"]["q"] == 0]
+    if q0:
+        for q in sorted({r["params"]["q"] for r in results if r["params"]["q"] > 0}):
+            phiq = statistics.fmean(r["phi"] for r in results if r["params"]["q"] == q)
+            print(f"  q = {q:g} e0: phi_0/phi - 1 = {statistics.fmean(q0) / phiq - 1:+.3f}")
     print()
     print("paper (physics.md sec. 3): neutral phi_0 = 0.270-0.363; charge lowers phi and <Z>;"
           " phi_0/phi - 1 ~ q^2, up to 40 %")
     # the paper's Table 2: charge the formed neutral packing, relax, compare
-    neutral = [r for r in results if r["params"]["q"] == 0]
+    neutral = sorted([r for r in results if r["params"]["q"] == 0], key=lambda r: r["params"]["seed"])
     if neutral and have_fmm:
         from .after_formation import run_table2
         print("charged after formation (the paper's Table 2; relaxation 100 r_p/U0 per charge):")
@@ -88,7 +104,7 @@ def main(argv=None):
         print("paper's Table 2: phi 0.3249 -> 0.3247, <Z> 3.2056 unchanged for q = 0 -> 400 e0")
         print()
     print(f"figures ({len(paths)} PNG + CSV) and tables: {figdir}")
-    print(f"this was REDUCED (N = {a.N}, L = {DEMO_VARS['L_rp']} r_p, one seed, Coulomb force "
+    print(f"this was REDUCED (N = {a.N}, L = {DEMO_VARS['L_rp']} r_p, {len(a.seeds)} seeds, Coulomb force "
           f"recomputed every {DEMO_VARS['coul_every']} steps); the full paper set (N = 2000, "
           "L = 28 r_p, all its cases, 3 seeds; hours) is:")
     print(f"  . build/env.sh && {FULL_COMMAND}")

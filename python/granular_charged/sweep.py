@@ -12,6 +12,7 @@ import itertools
 import json
 import sys
 import time
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from pathlib import Path
 
 from .params import DepositionParams
@@ -44,32 +45,46 @@ def _l(v):
 
 
 def run_sweep(params: list[DepositionParams], out: Path, build=None, np_ranks=1,
-              tracer=0, stream=sys.stdout, keep_going=True) -> list[dict]:
-    """Run every parameter set not yet finished in out/; print one progress line per run."""
+              tracer=0, stream=sys.stdout, keep_going=True, jobs=1) -> list[dict]:
+    """Run every parameter set not yet finished in out/ (``jobs`` runs at a time, each with
+    ``np_ranks`` MPI ranks); print one progress line per run as it finishes."""
     build = find_build(build)
     have_fmm = lammps_has(build, "fix", "coul/fmm")
     results = []
     t_start = time.monotonic()
     n = len(params)
+    todo = []
     for k, p in enumerate(params, 1):
-        head = f"[{k:>3}/{n}] {p.key():<48}"
         if p.q and not have_fmm:
-            print(f"{head} NOT RUN: charged runs need fix coul/fmm, absent from {build}",
-                  file=stream, flush=True)
-            continue
-        try:
-            r = run_deposition(p, out, build, np_ranks=np_ranks, tracer=tracer)
-        except RunError as e:
-            print(f"{head} FAILED: {str(e).splitlines()[0]}", file=stream, flush=True)
-            if not keep_going:
-                raise
-            continue
-        results.append(r)
-        el = time.monotonic() - t_start
-        state = "skipped (finished before)" if r.get("skipped") else f"{r['wall_s']:7.1f} s"
-        print(f"{head} {state}  phi = {r['phi']:.4f}  <Z> = {r['Z']:.3f}  lost {r['lost']}  "
-              f"flying {int(r['deck'].get('flying') or 0)}  | elapsed {el:6.0f} s",
-              file=stream, flush=True)
+            print(f"[{k:>3}/{n}] {p.key():<48} NOT RUN: charged runs need fix coul/fmm, absent "
+                  f"from {build}", file=stream, flush=True)
+        else:
+            todo.append((k, p))
+    done = 0
+
+    def one(kp):
+        k, p = kp
+        tr = tracer(p) if callable(tracer) else tracer
+        return k, p, run_deposition(p, out, build, np_ranks=np_ranks, tracer=tr)
+
+    with ThreadPoolExecutor(max(1, jobs)) as ex:
+        futs = [ex.submit(one, kp) for kp in todo]
+        for f in as_completed(futs):
+            done += 1
+            try:
+                k, p, r = f.result()
+            except RunError as e:
+                print(f"[{done:>3}/{len(todo)}] FAILED: {str(e).splitlines()[0]}", file=stream,
+                      flush=True)
+                if not keep_going:
+                    raise
+                continue
+            results.append(r)
+            el = time.monotonic() - t_start
+            state = "skipped (finished before)" if r.get("skipped") else f"{r['wall_s']:7.1f} s"
+            print(f"[{done:>3}/{len(todo)}] {p.key():<48} {state}  phi = {r['phi']:.4f}  "
+                  f"<Z> = {r['Z']:.3f}  lost {r['lost']}  flying {int(r['deck'].get('flying') or 0)}"
+                  f"  | elapsed {el:6.0f} s", file=stream, flush=True)
     return results
 
 
@@ -94,6 +109,7 @@ def main(argv=None):
     ap.add_argument("--N", type=int, default=2000)
     ap.add_argument("--seeds", type=int, nargs="+", default=[4711])
     ap.add_argument("--np", type=int, default=1, help="MPI ranks per run (mpirun)")
+    ap.add_argument("--jobs", type=int, default=1, help="runs at a time")
     ap.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
                     help="any other deck variable, e.g. --var farfield average --var L_rp 14")
     ap.add_argument("--tracer", type=int, default=0, help="follow this particle id (Fig. 8)")
@@ -106,7 +122,7 @@ def main(argv=None):
         params = expand([dict(rp=a.rp, U0=a.U0, gamma=a.gamma, q=a.q)], a.N, a.seeds, extra)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    run_sweep(params, out, a.build_dir, a.np, a.tracer)
+    run_sweep(params, out, a.build_dir, a.np, a.tracer, jobs=a.jobs)
     if a.figures:
         from . import figures
         figures.all_figures(load_results(out), Path(a.figures))

@@ -5,15 +5,14 @@ Small case: N = 250 in L = 10 r_p (2.5 particles per r_p^2 of floor, as the pape
 is unchanged), H = 160 r_p, injection gap 1 r_p, Coulomb force recomputed every 10 steps.
 
 Charged looser than neutral: a statistical test over three seeds, q = 0 vs q = 400 e_0
-(E* = 0.59), comparing the seed-averaged phi and <Z>. Measured on this machine (doc/deposition.md),
-seeds 1-4: neutral phi = 0.429, 0.453, 0.428, 0.427 (mean 0.434, sd 0.013), charged phi =
-0.426, 0.417, 0.420, 0.404 (mean 0.417, sd 0.010). A single pair can come out either way at
-this size (seed 1: 0.4288 vs 0.4264, and its <Z> is higher when charged); the means of three
-seeds differ by ~1.9 standard errors. The runs are deterministic for a given build, so the test
-is reproducible here; after a change of the physics it is a fresh draw that would fail with
-~3 % probability even if the charge effect stayed the same: the price of a < 3 min test, the
-effect being weak at this size (doc/deposition.md). Six runs, two at a time: ~2 min on an idle
-2-core machine.
+(E* = 0.59): the seed-averaged phi must be lower when charged. Measured on this machine
+(doc/deposition.md), seeds 1-4: neutral phi = 0.4328, 0.4358, 0.4392, 0.4484 (mean 0.439,
+sd 0.007), charged phi = 0.4216, 0.4188, 0.4221, 0.4118 (mean 0.419, sd 0.005): the three-seed
+means differ by 4 standard errors (a fresh draw after a change of the physics, with the same
+charge effect, would fail well below 1 % of the time). <Z> is printed, not asserted: its charge
+effect (4.00 -> 3.91) is only ~2 standard errors of a three-seed mean, and seed 1 alone has it
+the other way (3.937 neutral, 3.962 charged). The runs are deterministic for a given build.
+Six runs, two at a time: ~1.5 min on an idle 2-core machine.
 """
 import statistics
 from concurrent.futures import ThreadPoolExecutor
@@ -73,7 +72,6 @@ def test_charged_looser_than_neutral(runs):
     print(f"phi neutral {[round(r['phi'], 4) for r in n]}, charged {[round(r['phi'], 4) for r in c]}")
     print(f"<Z> neutral {[round(r['Z'], 3) for r in n]}, charged {[round(r['Z'], 3) for r in c]}")
     assert mean(c, "phi") < mean(n, "phi")
-    assert mean(c, "Z") < mean(n, "Z")
 
 
 def test_resumable(runs):
