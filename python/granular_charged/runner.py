@@ -55,8 +55,18 @@ def child_env(build: Path) -> dict:
     return env
 
 
+_HAS_CACHE: dict = {}
+
+
 def lammps_has(build: Path, category: str, style: str) -> bool:
     """Whether the build's LAMMPS has a style (asked in a child process, via the module)."""
+    key = (str(build), category, style)
+    if key not in _HAS_CACHE:
+        _HAS_CACHE[key] = _lammps_has(build, category, style)
+    return _HAS_CACHE[key]
+
+
+def _lammps_has(build: Path, category: str, style: str) -> bool:
     code = ("from lammps import lammps; l = lammps(cmdargs=['-log','none','-screen','none']); "
             f"print(int(l.has_style({category!r}, {style!r}))); l.close()")
     r = subprocess.run([sys.executable, "-c", code], env=child_env(build), capture_output=True,
@@ -144,6 +154,10 @@ def run_deposition(p: DepositionParams, root: Path, build: Path | None = None,
             return res
     variables = p.deck_vars()
     variables["out"] = "."
+    if "computes" not in variables:
+        # the package's analysis computes, when built; else phi and <Z> come from Python only
+        have = all(lammps_has(build, "compute", c) for c in ("packing/slab", "coord/dist"))
+        variables["computes"] = "1" if have else "0"
     if tracer:
         variables["tracer"] = str(tracer)
     wall = run_deck(workdir, variables, build, np_ranks, DECK, timeout)
