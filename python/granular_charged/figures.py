@@ -140,6 +140,9 @@ def phi_vs_q(results, out: Path):
 def rdf(results, out: Path, nbins=150):
     """g(r) of the analysis slab, neutral vs the most charged run of one series (Fig. 4)."""
     g = _group(results)
+    if not g:
+        print("figure rdf: no run with an analysis slab")
+        return None
     key = max(g, key=lambda k: (len(g[k]), k))
     byq = g[key]
     qs = sorted(byq)
@@ -199,6 +202,9 @@ def force_pdf(results, out: Path, bins=60):
     """pdf of the normal contact forces F_n / F_C (Fig. 7), from compute pair/local (the
     deck's forces.dump: distance, signed normal force, > 0 repulsive), all particle pairs."""
     g = _group(results)
+    if not g:
+        print("figure force_pdf: no run with an analysis slab")
+        return None
     key = max(g, key=lambda k: (len(g[k]), k))
     fig, ax = plt.subplots(figsize=(5, 4))
     edges = np.linspace(-0.2, 0.2, bins + 1)
