@@ -59,7 +59,12 @@ class DepositionParams:
         return float(self.extra.get("L_rp", 28)) * self.rp
 
     def groups(self) -> dict:
-        return dimensionless(self.gamma, self.rho, self.U0, self.rp, self.q)
+        """Ad, E*, Ad* with the paper's K_eff = 20 N (L/r_p)^-2 for this N and L (51.0 for
+        N = 2000, L = 28 r_p, and for the demo's N = 500, L = 14 r_p)."""
+        K = 20.0 * self.N / float(self.extra.get("L_rp", 28)) ** 2
+        d = dimensionless(self.gamma, self.rho, self.U0, self.rp, self.q, K_eff=K)
+        d["K_eff"] = K
+        return d
 
 
 def pair_modulus(E: float, nu: float) -> float:
