@@ -5,6 +5,8 @@
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 LAMMPS_SOURCE_DIR ?=
+# ccache: paths relative to the checkout, so a fresh clone elsewhere reuses the cache
+export CCACHE_BASEDIR := $(CURDIR)
 export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 
