@@ -89,6 +89,7 @@ def _child(deck: str, workdir: str, variables: list[tuple[str, str]]) -> int:
         lmp.file(deck)
     finally:
         lmp.close()
+        lmp.finalize()   # MPI_Finalize: without it mpirun reports a failure at exit
     return 0
 
 
