@@ -12,7 +12,8 @@ set -euo pipefail
 
 readonly DEB_VERSION="20250204+dfsg.1-2"
 readonly ORIG_TARBALL="lammps_20250204+dfsg.1.orig.tar.xz"
-readonly ORIG_SHA256="3671165bd52fad36734e0a9136c5bc5ecb225e03988f8c89aa13366a8b53b1c7"
+# GC_LAMMPS_ORIG_SHA256 exists only to exercise the checksum-failure path (doc/build.md)
+readonly ORIG_SHA256="${GC_LAMMPS_ORIG_SHA256:-3671165bd52fad36734e0a9136c5bc5ecb225e03988f8c89aa13366a8b53b1c7}"
 readonly TREE_NAME="lammps-20250204"
 
 fail() {
@@ -66,6 +67,9 @@ apt_opts=(-o "Dir::Etc::SourceList=$work/sources.list" -o "Dir::Etc::SourceParts
 echo "-- LAMMPS: reading the trixie source index from $mirror" >&2
 apt-get "${apt_opts[@]}" -q update >&2 || fail "apt-get update (deb-src trixie at $mirror)" \
   "the archive could not be reached"
+# apt-get update exits 0 even when every fetch failed: the source index must be there
+compgen -G "$work/lists/*Sources*" >/dev/null || fail "apt-get update (deb-src trixie at $mirror)" \
+  "no source index was downloaded (archive unreachable, or no trixie suite there)"
 echo "-- LAMMPS: downloading source package lammps=$DEB_VERSION" >&2
 # apt-get may report a missing .dsc (HTTP 404) yet have the tarball: the checksum decides
 (cd "$work/download" && apt-get "${apt_opts[@]}" -q source --download-only "lammps=$DEB_VERSION" >&2) || true
