@@ -32,8 +32,9 @@ using namespace FixConst;
 /* ---------------------------------------------------------------------- */
 
 FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), opts(new gcfmm::Options), every(1), last_computed(-1), bed_given(false),
-    energy_local(0.0), energy_all(0.0), energy_summed(false), field(nullptr), logged(false)
+    Fix(lmp, narg, arg), opts(new gcfmm::Options), every(1), last_computed(-1), natoms_computed(-1),
+    bed_given(false), energy_local(0.0), energy_all(0.0), energy_summed(false), field(nullptr),
+    logged(false)
 {
   scalar_flag = 1;
   extscalar = 1;
@@ -44,6 +45,7 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
   size_peratom_cols = 4;
   peratom_freq = 1;
   dynamic_group_allow = 1;
+  create_attribute = 1;    // atoms created by other fixes get a zero stored field (set_arrays)
 
   opts->accuracy = 1e-4;
   opts->images = 1;
@@ -208,9 +210,12 @@ void FixCoulFMM::post_force(int vflag)
 {
   v_init(vflag);
   const bigint step = update->ntimestep;
-  if (last_computed < 0 || step - last_computed >= every) {
+  // recompute on schedule, and whenever atoms were added or removed (e.g. fix deposit): a new
+  // atom must feel, and exert, the Coulomb force from its first step
+  if (last_computed < 0 || step - last_computed >= every || atom->natoms != natoms_computed) {
     compute_field();
     last_computed = step;
+    natoms_computed = atom->natoms;
   }
   apply_field(vflag);
 }
@@ -413,6 +418,11 @@ void FixCoulFMM::grow_arrays(int nmax)
 void FixCoulFMM::copy_arrays(int i, int j, int /*delflag*/)
 {
   for (int k = 0; k < 4; k++) field[j][k] = field[i][k];
+}
+
+void FixCoulFMM::set_arrays(int i)
+{
+  for (int k = 0; k < 4; k++) field[i][k] = 0.0;
 }
 
 int FixCoulFMM::pack_exchange(int i, double *buf_out)

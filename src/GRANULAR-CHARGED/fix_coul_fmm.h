@@ -45,15 +45,17 @@ class FixCoulFMM : public Fix {
 
   void grow_arrays(int) override;
   void copy_arrays(int, int, int) override;
+  void set_arrays(int) override;
   int pack_exchange(int, double *) override;
   int unpack_exchange(int, double *) override;
 
  private:
   std::unique_ptr<gcfmm::Options> opts;    // solver options from the keywords
   std::unique_ptr<gcfmm::Solver> solver;
-  int every;               // recompute every this many steps
-  bigint last_computed;    // step of the last FMM evaluation (-1: none yet)
-  bool bed_given;          // bed zlo/zhi given by the user (farfield average)
+  int every;                 // recompute every this many steps
+  bigint last_computed;      // step of the last FMM evaluation (-1: none yet)
+  bigint natoms_computed;    // atom count at that evaluation (atoms added -> recompute)
+  bool bed_given;            // bed zlo/zhi given by the user (farfield average)
   double energy_local, energy_all;
   bool energy_summed;
   double **field;    // per atom: Ex, Ey, Ez, potential (force/charge, energy/charge)

@@ -319,6 +319,32 @@ TEST(CoulFMM, PerAtomFieldEveryVirialDielectric)
   }
 }
 
+// atoms inserted by fix deposit between two scheduled evaluations (every 10) feel the field
+// from their first step: the fix recomputes when the atom count changes (and a created atom
+// starts from a zero stored field, never uninitialised memory)
+TEST(CoulFMM, EveryWithDeposit)
+{
+  if (nprocs() > 1) GTEST_SKIP();
+  {
+    FILE *fp = fopen("coul_fmm_particle.mol", "w");
+    fputs("# charged particle\n\n1 atoms\n\nCoords\n\n1 0 0 0\n\nTypes\n\n1 1\n\nCharges\n\n1 1.0\n", fp);
+    fclose(fp);
+  }
+  Lmp l;
+  random_charges(l, "p p f", 100, 20.0, 60.0, 5);
+  l.cmds({"region top block 0 20 0 20 50 55", "molecule part coul_fmm_particle.mol",
+          "fix nve all nve", "timestep 0.1",
+          "fix feed all deposit 3 0 7 4711 region top mol part near 1.0 vz -0.01 -0.01",
+          "fix fmm all coul/fmm accuracy 1e-6 every 10", "run 0 post no", "run 8 post no"});
+  // fix deposit inserts on steps 1 and 8: neither is a scheduled evaluation (0, 10)
+  ASSERT_EQ(l.var("count(all)"), 102.0);
+  const double ez_new = l.var("F_fmm[102][3]");    // stored field of the atom inserted at step 8
+  EXPECT_NE(ez_new, 0.0);
+  l.cmd("run 0 post no");    // a fresh evaluation at the same positions
+  EXPECT_NEAR(l.var("F_fmm[102][3]"), ez_new, 1e-9 * std::fabs(ez_new));
+  std::remove("coul_fmm_particle.mol");
+}
+
 // a run continued from a restart file equals the uninterrupted run
 TEST(CoulFMM, Restart)
 {
