@@ -31,6 +31,7 @@
 #include "neigh_list.h"
 #include "neighbor.h"
 #include "pair.h"
+#include "slab_bounds.h"
 #include "update.h"
 
 #include <cmath>
@@ -58,12 +59,7 @@ ComputeCoordDist::ComputeCoordDist(LAMMPS *lmp, int narg, char **arg) :
   while (iarg < narg) {
     if (strcmp(arg[iarg], "z") == 0) {
       if (iarg + 3 > narg) utils::missing_cmd_args(FLERR, "compute coord/dist z", error);
-      zlo_null = (strcmp(arg[iarg + 1], "NULL") == 0);
-      zhi_null = (strcmp(arg[iarg + 2], "NULL") == 0);
-      if (!zlo_null) zlo = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
-      if (!zhi_null) zhi = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
-      if (!zlo_null && !zhi_null && zlo >= zhi)
-        error->all(FLERR, iarg + 1, "Compute coord/dist z: zlo {} must be < zhi {}", zlo, zhi);
+      parse_slab_bounds(lmp, arg, iarg + 1, "Compute coord/dist z:", zlo, zhi, zlo_null, zhi_null);
       iarg += 3;
     } else if (strcmp(arg[iarg], "contact") == 0) {
       if (iarg + 2 > narg) utils::missing_cmd_args(FLERR, "compute coord/dist contact", error);

@@ -22,6 +22,7 @@
 #include "domain.h"
 #include "error.h"
 #include "math_const.h"
+#include "slab_bounds.h"
 #include "update.h"
 
 #include <cmath>
@@ -50,12 +51,7 @@ ComputePackingSlab::ComputePackingSlab(LAMMPS *lmp, int narg, char **arg) : Comp
     error->all(FLERR, "Compute packing/slab requires atom style sphere (per-atom radius)");
   if (narg > 5) error->all(FLERR, 5, "Unknown compute packing/slab keyword: {}", arg[5]);
 
-  zlo_null = (strcmp(arg[3], "NULL") == 0);
-  zhi_null = (strcmp(arg[4], "NULL") == 0);
-  zlo = zlo_null ? 0.0 : utils::numeric(FLERR, arg[3], false, lmp);
-  zhi = zhi_null ? 0.0 : utils::numeric(FLERR, arg[4], false, lmp);
-  if (!zlo_null && !zhi_null && zlo >= zhi)
-    error->all(FLERR, 3, "Compute packing/slab zlo {} must be < zhi {}", zlo, zhi);
+  parse_slab_bounds(lmp, arg, 3, "Compute packing/slab", zlo, zhi, zlo_null, zhi_null);
   check_box();
 
   scalar_flag = 1;
