@@ -33,6 +33,16 @@ def _csv(path: Path, header, rows):
         w.writerows(rows)
 
 
+def _save(fig, path: Path, header, rows, tight=True):
+    """Write the figure as PNG and its data as CSV next to it (same stem), close the figure."""
+    if tight:
+        fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+    _csv(path.with_suffix(".csv"), header, rows)
+    return path
+
+
 def _series_key(r):
     p = r["params"]
     return (p["rp"], p["U0"], p["gamma"])
@@ -74,12 +84,8 @@ def snapshot(result, out: Path, name="snapshot_Z.png"):
     p = result["params"]
     ax.set_title(f"q = {p['q']:g} e0, N = {p['N']}, phi = {result['phi']:.3f}, <Z> = {result['Z']:.2f}",
                  fontsize=9)
-    path = out / name
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-    _csv(path.with_suffix(".csv"), ["id", "x", "y", "z", "radius", "Z"],
-         zip(snap["id"], snap["x"], snap["y"], snap["z"], snap["radius"], Z))
-    return path
+    return _save(fig, out / name, ["id", "x", "y", "z", "radius", "Z"],
+                 zip(snap["id"], snap["x"], snap["y"], snap["z"], snap["radius"], Z), tight=False)
 
 
 def phi_vs_q(results, out: Path):
@@ -115,11 +121,7 @@ def phi_vs_q(results, out: Path):
     ax.set_xlabel("q / e0")
     ax.set_ylabel("phi")
     ax.legend(fontsize=6)
-    fig.tight_layout()
-    p1 = out / "phi_vs_q.png"
-    fig.savefig(p1, dpi=130)
-    plt.close(fig)
-    _csv(p1.with_suffix(".csv"), ["rp", "U0", "gamma", "q_e0", "phi_mean", "phi_sd", "runs"], rows)
+    p1 = _save(fig, out / "phi_vs_q.png", ["rp", "U0", "gamma", "q_e0", "phi_mean", "phi_sd", "runs"], rows)
     p2 = None
     if any_exp:
         qref = np.array([50, 500])
@@ -167,12 +169,8 @@ def rdf(results, out: Path, nbins=150):
     ax.set_xlim(0.8, 3.0)
     ax.set_title(_label(key), fontsize=8)
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    path = out / "rdf.png"
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-    _csv(path.with_suffix(".csv"), ["r_over_2rp"] + [f"g_q{q:g}" for q in cols],
-         zip(x, *cols.values()))
+    path = _save(fig, out / "rdf.png", ["r_over_2rp"] + [f"g_q{q:g}" for q in cols],
+                 zip(x, *cols.values()))
     return path
 
 
@@ -190,11 +188,7 @@ def fZ(results, out: Path):
     ax.set_ylabel("f(Z)")
     ax.set_xlim(-0.5, 10.5)
     ax.legend(fontsize=5)
-    fig.tight_layout()
-    path = out / "fZ.png"
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-    _csv(path.with_suffix(".csv"), ["rp", "U0", "gamma", "q_e0"] + [f"f{z}" for z in range(13)], rows)
+    path = _save(fig, out / "fZ.png", ["rp", "U0", "gamma", "q_e0"] + [f"f{z}" for z in range(13)], rows)
     return path
 
 
@@ -226,11 +220,7 @@ def force_pdf(results, out: Path, bins=60):
     ax.set_ylabel("pdf")
     ax.set_title(_label(key), fontsize=8)
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    path = out / "force_pdf.png"
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-    _csv(path.with_suffix(".csv"), ["Fn_over_FC"] + [f"pdf_q{q:g}" for q in cols], zip(c, *cols.values()))
+    path = _save(fig, out / "force_pdf.png", ["Fn_over_FC"] + [f"pdf_q{q:g}" for q in cols], zip(c, *cols.values()))
     return path
 
 
@@ -272,11 +262,7 @@ def tracer_energy(results, out: Path):
     ax.set_xlabel("gap to nearest deposited particle / r_p")
     ax.set_ylabel("E_k / E_k0")
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    path = out / "tracer_energy.png"
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-    _csv(path.with_suffix(".csv"), ["q_e0", "gap_over_rp", "Ek_over_Ek0"], rows)
+    path = _save(fig, out / "tracer_energy.png", ["q_e0", "gap_over_rp", "Ek_over_Ek0"], rows)
     return path
 
 
@@ -320,10 +306,7 @@ def vs_adstar(results, out: Path):
     ax.legend(fontsize=7, loc="upper left")
     fig.text(0.01, 0.005, "\n".join(_wrap(G2_NOTE, 95)), fontsize=5.5, va="bottom")
     fig.subplots_adjust(bottom=0.2)
-    p2 = out / "phase_diagram_Z_phi.png"
-    fig.savefig(p2, dpi=130)
-    plt.close(fig)
-    _csv(p2.with_suffix(".csv"), hdr, rows)
+    p2 = _save(fig, out / "phase_diagram_Z_phi.png", hdr, rows, tight=False)
     return p1, p2
 
 
