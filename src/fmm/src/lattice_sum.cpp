@@ -43,6 +43,41 @@ void trig_table(double theta, int mmax, std::vector<double> &c, std::vector<doub
   }
 }
 
+// Reciprocal-space sum shared by the Fourier and Ewald forms: over k = 2 pi (mx/lx, my/ly) != 0
+// with |k| <= kmax, of p(k) cos(k.rho) and its x, y derivatives, and of q(k) cos(k.rho), where
+// radial(k, p, q) gives the profile p and its z-derivative term q. The sum runs over the
+// quadrant mx, my >= 0: cos(kx x + ky y) summed over the sign choices of (kx, ky) is
+// 4 cos(kx x) cos(ky y) (2 if one component is zero).
+template <class Radial>
+void reciprocal_sum(double dx, double dy, double lx, double ly, double kmax, Radial radial,
+                    double &s0, double &sx0, double &sy0, double &sz) {
+  const double bx = 2.0 * kPi / lx, by = 2.0 * kPi / ly;
+  const int mx = static_cast<int>(kmax / bx), my = static_cast<int>(kmax / by);
+  thread_local std::vector<double> cx, sx, cy, sy;
+  trig_table(bx * dx, mx, cx, sx);
+  trig_table(by * dy, my, cy, sy);
+  s0 = sx0 = sy0 = sz = 0.0;
+  const double kmax2 = kmax * kmax;
+  for (int ix = 0; ix <= mx; ++ix) {
+    const double kx = bx * ix;
+    const double wx = ix ? 2.0 : 1.0;
+    for (int iy = 0; iy <= my; ++iy) {
+      if (ix == 0 && iy == 0) continue;
+      const double ky = by * iy;
+      const double k2 = kx * kx + ky * ky;
+      if (k2 > kmax2) break;
+      double p, q;
+      radial(std::sqrt(k2), p, q);
+      const double w = wx * (iy ? 2.0 : 1.0);
+      const double cc = cx[ix] * cy[iy];
+      s0 += w * cc * p;
+      sx0 -= w * kx * sx[ix] * cy[iy] * p;
+      sy0 -= w * ky * cx[ix] * sy[iy] * p;
+      sz += w * cc * q;
+    }
+  }
+}
+
 inline double reduce(double d, double l) { return d - l * std::nearbyint(d / l); }
 
 void set_out(double *p, double v) {
@@ -69,32 +104,13 @@ void periodic_green_fourier(double dx, double dy, double dz, double lx, double l
   const double az = std::fabs(dz), sg = dz > 0 ? 1.0 : -1.0;
   const double area = lx * ly;
   const double kmax = kFourierDecay / az;
-  const double bx = 2.0 * kPi / lx, by = 2.0 * kPi / ly;
-  const int mx = static_cast<int>(kmax / bx), my = static_cast<int>(kmax / by);
-  thread_local std::vector<double> cx, sx, cy, sy;
-  trig_table(bx * dx, mx, cx, sx);
-  trig_table(by * dy, my, cy, sy);
-  // Sum over the quadrant mx, my >= 0: cos(kx x + ky y) summed over the sign choices of
-  // (kx, ky) is 4 cos(kx x) cos(ky y) (2 if one component is zero).
-  double sg0 = 0, sgx = 0, sgy = 0, sgz = 0;
-  const double kmax2 = kmax * kmax;
-  for (int ix = 0; ix <= mx; ++ix) {
-    const double kx = bx * ix;
-    const double wx = ix ? 2.0 : 1.0;
-    for (int iy = 0; iy <= my; ++iy) {
-      if (ix == 0 && iy == 0) continue;
-      const double ky = by * iy;
-      const double k2 = kx * kx + ky * ky;
-      if (k2 > kmax2) break;
-      const double k = std::sqrt(k2);
-      const double w = wx * (iy ? 2.0 : 1.0) * std::exp(-k * az);
-      const double cc = cx[ix] * cy[iy];
-      sg0 += w * cc / k;
-      sgx -= w * kx * sx[ix] * cy[iy] / k;
-      sgy -= w * ky * cx[ix] * sy[iy] / k;
-      sgz += w * cc;
-    }
-  }
+  double sg0, sgx, sgy, sgz;
+  reciprocal_sum(dx, dy, lx, ly, kmax,
+                 [az](double k, double &p, double &q) {
+                   q = std::exp(-k * az);
+                   p = q / k;
+                 },
+                 sg0, sgx, sgy, sgz);
   const double f = 2.0 * kPi / area;
   set_out(g, f * (sg0 - az));
   set_out(gx, f * sgx);
@@ -145,35 +161,17 @@ void ewald_sum(double dx, double dy, double dz, double lx, double ly, int nx0, i
   // reciprocal space, k != 0
   const double az = std::fabs(dz), sg = dz >= 0 ? 1.0 : -1.0;
   const double kmax = kEwaldKmax * alpha;
-  const double bx = 2.0 * kPi / lx, by = 2.0 * kPi / ly;
-  const int mx = static_cast<int>(kmax / bx), my = static_cast<int>(kmax / by);
-  thread_local std::vector<double> cx, sx, cy, sy;
-  trig_table(bx * dx, mx, cx, sx);
-  trig_table(by * dy, my, cy, sy);
-  double r0 = 0, rx = 0, ry = 0, rz = 0;
-  const double kmax2 = kmax * kmax;
-  for (int ix = 0; ix <= mx; ++ix) {
-    const double kx = bx * ix;
-    const double wx = ix ? 2.0 : 1.0;
-    for (int iy = 0; iy <= my; ++iy) {
-      if (ix == 0 && iy == 0) continue;
-      const double ky = by * iy;
-      const double k2 = kx * kx + ky * ky;
-      if (k2 > kmax2) break;
-      const double k = std::sqrt(k2);
-      const double up = k / (2.0 * alpha) + alpha * az, um = k / (2.0 * alpha) - alpha * az;
-      const double ep = std::exp(k * az) * std::erfc(up);
-      const double em = std::exp(-k * az) * std::erfc(um);
-      const double w = wx * (iy ? 2.0 : 1.0) / k;
-      const double cc = cx[ix] * cy[iy];
-      const double f = ep + em;
-      r0 += w * cc * f;
-      rx -= w * kx * sx[ix] * cy[iy] * f;
-      ry -= w * ky * cx[ix] * sy[iy] * f;
-      // d/dz of F: the Gaussian terms of the two erfc derivatives cancel
-      rz += w * cc * sg * k * (ep - em);
-    }
-  }
+  double r0, rx, ry, rz;
+  reciprocal_sum(dx, dy, lx, ly, kmax,
+                 [az, alpha, sg](double k, double &p, double &q) {
+                   const double up = k / (2.0 * alpha) + alpha * az, um = k / (2.0 * alpha) - alpha * az;
+                   const double ep = std::exp(k * az) * std::erfc(up);
+                   const double em = std::exp(-k * az) * std::erfc(um);
+                   p = (ep + em) / k;
+                   // d/dz of the profile: the Gaussian terms of the two erfc derivatives cancel
+                   q = sg * (ep - em);
+                 },
+                 r0, rx, ry, rz);
   const double pa = kPi / area;
   const double ez = std::erf(alpha * az);
   set_out(g, s0 + pa * r0 - 2.0 * pa * (az * ez + std::exp(-a2 * dz * dz) / (alpha * std::sqrt(kPi))));
