@@ -287,18 +287,15 @@ void FixCoulFMM::compute_field()
     for (int k = 0; k < 4; k++) field[i][k] = 0.0;
   if (n == 0) return;
 
-  gpot.assign(n, 0.0);
-  gex.assign(n, 0.0);
-  gey.assign(n, 0.0);
-  gez.assign(n, 0.0);
+  result.assign(4 * n, 0.0);
+  double *pot = result.data(), *ex = pot + n, *ey = pot + 2 * n, *ez = pot + 3 * n;
 
   std::string failure;
   try {
     if (opts->boundary == gcfmm::Boundary::Periodic2D)
       solver->set_box(domain->boxlo[0], domain->boxlo[1], domain->xprd, domain->yprd);
     solver->build(n, gx.data(), gy.data(), gz.data());
-    solver->evaluate(gq.data(), gpot.data(), gex.data(), gey.data(), gez.data(), comm->me,
-                     comm->nprocs);
+    solver->evaluate(gq.data(), pot, ex, ey, ez, comm->me, comm->nprocs);
   } catch (std::exception &e) {
     failure = e.what();
     if (failure.empty()) failure = "unknown error";
@@ -314,12 +311,8 @@ void FixCoulFMM::compute_field()
     error->all(FLERR, Error::NOLASTLINE, "Fix coul/fmm: FMM library: {}", failure);
   }
 
-  std::vector<double> sum(4 * n);
-  std::copy(gpot.begin(), gpot.end(), sum.begin());
-  std::copy(gex.begin(), gex.end(), sum.begin() + n);
-  std::copy(gey.begin(), gey.end(), sum.begin() + 2 * n);
-  std::copy(gez.begin(), gez.end(), sum.begin() + 3 * n);
-  if (comm->nprocs > 1) MPI_Allreduce(MPI_IN_PLACE, sum.data(), 4 * n, MPI_DOUBLE, MPI_SUM, world);
+  if (comm->nprocs > 1)
+    MPI_Allreduce(MPI_IN_PLACE, result.data(), 4 * n, MPI_DOUBLE, MPI_SUM, world);
 
   // bare 1/r kernel -> LAMMPS units: qqrd2e includes the dielectric constant
   const double c = force->qqrd2e;
@@ -329,10 +322,10 @@ void FixCoulFMM::compute_field()
   for (int i = 0; i < nlocal; i++) {
     if (!(mask[i] & groupbit) || q[i] == 0.0) continue;
     const size_t k = std::lower_bound(gtag.begin(), gtag.end(), tag[i]) - gtag.begin();
-    field[i][0] = c * sum[n + k];
-    field[i][1] = c * sum[2 * n + k];
-    field[i][2] = c * sum[3 * n + k];
-    field[i][3] = c * sum[k];
+    field[i][0] = c * ex[k];
+    field[i][1] = c * ey[k];
+    field[i][2] = c * ez[k];
+    field[i][3] = c * pot[k];
   }
 
   if (!logged && comm->me == 0) {
@@ -403,7 +396,7 @@ double FixCoulFMM::compute_scalar()
 double FixCoulFMM::memory_usage()
 {
   double bytes = 4.0 * atom->nmax * sizeof(double);
-  bytes += (double) (gx.capacity() * 9) * sizeof(double);
+  bytes += (double) (gx.capacity() * 9) * sizeof(double);    // gathered atoms and results
   return bytes;
 }
 

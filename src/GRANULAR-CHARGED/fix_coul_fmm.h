@@ -62,7 +62,8 @@ class FixCoulFMM : public Fix {
   bool logged;
 
   // gathered charged atoms of the group, sorted by atom ID (identical on every rank)
-  std::vector<double> gx, gy, gz, gq, gpot, gex, gey, gez, buf;
+  std::vector<double> gx, gy, gz, gq, buf;
+  std::vector<double> result;    // potential, Ex, Ey, Ez of the gathered atoms, n each
   std::vector<tagint> gtag;
 
   void compute_field();
