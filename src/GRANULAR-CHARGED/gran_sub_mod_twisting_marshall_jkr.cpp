@@ -44,12 +44,13 @@ GranSubModTwistingMarshallJKR::GranSubModTwistingMarshallJKR(GranularModel *gm, 
 
 void GranSubModTwistingMarshallJKR::init()
 {
-  const std::string &tname = gm->tangential_model->name;
-  if (tname != "marshall" && tname.rfind("mindlin", 0) != 0)
+  // the Mindlin family (and tangential marshall, derived from it) holds k = 8 G*, scaled by a
+  // in the force; mindlin_classic is not of that family
+  if (!dynamic_cast<GranSubModTangentialMindlin *>(gm->tangential_model))
     error->all(FLERR,
                "Twisting marshall/jkr requires tangential model marshall or mindlin "
                "(stiffness 8 G* a), not {}",
-               tname);
+               gm->tangential_model->name);
   k_tang = gm->tangential_model->get_k();
   mu_tang = gm->tangential_model->get_mu();
 }
