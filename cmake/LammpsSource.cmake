@@ -1,17 +1,25 @@
 # Locate the LAMMPS source tree and verify it, or obtain Debian's source package.
 #
-# -D LAMMPS_SOURCE_DIR=<checkout>  use that tree (4Feb2025 or newer; never modified)
-# default                          fetch lammps 20250204+dfsg.1-2 from Debian (trixie deb-src)
+# -D LAMMPS_SOURCE_DIR=<checkout>  use that tree (a supported release; never modified)
+# -D LAMMPS_VERSION=<release>      which Debian source package to fetch when no tree is given:
+#                                  20260704 (default, 4Jul2026, sid) or 20250204 (4Feb2025, trixie),
 #                                  into GC_DEPS_DIR (default <repo>/.deps), sha256-checked
-# Result: GC_LAMMPS_DIR.
-set(LAMMPS_SOURCE_DIR "" CACHE PATH "Root of a LAMMPS checkout (4Feb2025 or newer); empty = Debian source package")
+# Result: GC_LAMMPS_DIR, GC_LAMMPS_VERSION (yyyymmdd of the tree) and the compatibility
+# definitions GC_LAMMPS_COMPILE_DEFINITIONS for the package sources (doc/build.md, "Releases").
+set(GC_SUPPORTED_LAMMPS_VERSIONS 20250204 20260704)    # oldest first, both tested by .ci/run
+set(GC_SUPPORTED_LAMMPS_NAMES "4Feb2025 (20250204) and 4Jul2026 (20260704)")
+set(LAMMPS_SOURCE_DIR "" CACHE PATH "Root of a LAMMPS checkout (4Feb2025 to 4Jul2026); empty = Debian source package")
+set(LAMMPS_VERSION 20260704 CACHE STRING "LAMMPS release fetched from Debian when LAMMPS_SOURCE_DIR is empty")
+set_property(CACHE LAMMPS_VERSION PROPERTY STRINGS ${GC_SUPPORTED_LAMMPS_VERSIONS})
 set(GC_DEPS_DIR "${CMAKE_CURRENT_SOURCE_DIR}/.deps" CACHE PATH "Cache folder for the downloaded LAMMPS source")
-set(GC_MIN_LAMMPS_VERSION 20250204)
 
+# Checks a tree before anything is built from it: complete, a supported release, and a
+# GRANULAR package whose sub-models are registered the way the overlay needs.
 function(gc_check_lammps_tree dir origin)
-  set(hint "Give -D LAMMPS_SOURCE_DIR=<root of a LAMMPS 4Feb2025 (or newer) checkout>, or leave it empty to use Debian's source package.")
+  set(hint "Supported LAMMPS releases: ${GC_SUPPORTED_LAMMPS_NAMES}. Give -D LAMMPS_SOURCE_DIR=<root of such a checkout>, or leave it empty to use Debian's source package (-D LAMMPS_VERSION=20260704 or 20250204).")
   foreach(f cmake/CMakeLists.txt cmake/Modules/StyleHeaderUtils.cmake src/version.h
-            src/GRANULAR/granular_model.h src/GRANULAR/gran_sub_mod.h python/lammps/core.py)
+            src/GRANULAR/granular_model.h src/GRANULAR/granular_model.cpp
+            src/GRANULAR/gran_sub_mod.h src/GRANULAR/gran_sub_mod_twisting.h python/lammps/core.py)
     if(NOT EXISTS "${dir}/${f}")
       message(FATAL_ERROR "LAMMPS source tree ${dir} (${origin}) is missing or incomplete: ${f} not found.\n${hint}")
     endif()
@@ -24,9 +32,44 @@ function(gc_check_lammps_tree dir origin)
     message(FATAL_ERROR "Cannot read the LAMMPS version from ${dir}/src/version.h.\n${hint}")
   endif()
   math(EXPR ver "${CMAKE_MATCH_3} * 10000 + (${mon} + 1) * 100 + ${CMAKE_MATCH_1}")
-  if(ver LESS GC_MIN_LAMMPS_VERSION)
-    message(FATAL_ERROR "LAMMPS in ${dir} is version ${ver}; GRANULAR-CHARGED needs ${GC_MIN_LAMMPS_VERSION} or newer (granular sub-model architecture).\n${hint}")
+  list(GET GC_SUPPORTED_LAMMPS_VERSIONS 0 oldest)
+  list(GET GC_SUPPORTED_LAMMPS_VERSIONS -1 newest)
+  if(ver LESS oldest OR ver GREATER newest)
+    message(FATAL_ERROR "LAMMPS in ${dir} (${origin}) is version ${ver}, outside the supported range ${oldest} to ${newest}.\n${hint}")
   endif()
+  if(NOT ver IN_LIST GC_SUPPORTED_LAMMPS_VERSIONS)
+    message(WARNING "LAMMPS version ${ver} lies between the supported releases but is not itself tested (${GC_SUPPORTED_LAMMPS_NAMES}).")
+  endif()
+
+  # The overlay adds its gran_sub_mod_*.h headers through RegisterStyles(), which only works
+  # while LAMMPS builds its sub-model table from the generated style_gran_sub_mod.h. Upstream
+  # development is replacing that with a hand-edited table (gran_sub_mod_register.cpp).
+  file(STRINGS "${dir}/cmake/Modules/StyleHeaderUtils.cmake" reg REGEX "GRAN_SUB_MOD_CLASS")
+  file(STRINGS "${dir}/src/GRANULAR/granular_model.cpp" inc REGEX "#include \"style_gran_sub_mod.h\"")
+  if(EXISTS "${dir}/src/GRANULAR/gran_sub_mod_register.cpp")
+    set(found "a hand-edited sub-model table, src/GRANULAR/gran_sub_mod_register.cpp")
+  elseif(NOT reg)
+    set(found "StyleHeaderUtils.cmake without GRAN_SUB_MOD_CLASS headers")
+  elseif(NOT inc)
+    set(found "granular_model.cpp without #include \"style_gran_sub_mod.h\"")
+  endif()
+  if(found)
+    message(FATAL_ERROR "LAMMPS in ${dir} (${origin}, version ${ver}) does not register granular "
+      "sub-models through the generated style_gran_sub_mod.h; found ${found}. "
+      "GRANULAR-CHARGED adds its sub-models through that header and cannot overlay this tree.\n${hint}")
+  endif()
+
+  # Compatibility points (one source for both releases): 4Jul2026 changed
+  # GranSubModTwisting::calculate_forces() to return the twisting moment instead of storing it.
+  file(STRINGS "${dir}/src/GRANULAR/gran_sub_mod_twisting.h" twist REGEX "virtual double calculate_forces")
+  set(defs GC_LAMMPS_VERSION=${ver})
+  if(twist)
+    list(APPEND defs GC_TWISTING_RETURNS_MOMENT=1)
+  else()
+    list(APPEND defs GC_TWISTING_RETURNS_MOMENT=0)
+  endif()
+  set(GC_LAMMPS_VERSION ${ver} PARENT_SCOPE)
+  set(GC_LAMMPS_COMPILE_DEFINITIONS ${defs} PARENT_SCOPE)
   message(STATUS "LAMMPS source: ${dir} (${origin}, version ${ver})")
 endfunction()
 
@@ -34,8 +77,11 @@ if(LAMMPS_SOURCE_DIR)
   get_filename_component(GC_LAMMPS_DIR "${LAMMPS_SOURCE_DIR}" ABSOLUTE)
   gc_check_lammps_tree("${GC_LAMMPS_DIR}" "LAMMPS_SOURCE_DIR")
 else()
+  if(NOT LAMMPS_VERSION IN_LIST GC_SUPPORTED_LAMMPS_VERSIONS)
+    message(FATAL_ERROR "LAMMPS_VERSION=${LAMMPS_VERSION} is not a supported release; supported: ${GC_SUPPORTED_LAMMPS_NAMES}.")
+  endif()
   execute_process(
-    COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/cmake/fetch-lammps-debian.sh ${GC_DEPS_DIR}
+    COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/cmake/fetch-lammps-debian.sh ${GC_DEPS_DIR} ${LAMMPS_VERSION}
     OUTPUT_VARIABLE fetched OUTPUT_STRIP_TRAILING_WHITESPACE
     RESULT_VARIABLE rc)
   if(NOT rc EQUAL 0)
@@ -43,5 +89,5 @@ else()
                         "Use -D LAMMPS_SOURCE_DIR=/path/to/lammps to build against your own checkout.")
   endif()
   set(GC_LAMMPS_DIR "${fetched}")
-  gc_check_lammps_tree("${GC_LAMMPS_DIR}" "Debian source package lammps 20250204+dfsg.1-2")
+  gc_check_lammps_tree("${GC_LAMMPS_DIR}" "Debian source package of LAMMPS ${LAMMPS_VERSION}")
 endif()

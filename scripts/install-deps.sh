@@ -3,9 +3,10 @@
 # All come from Debian's own archive (no pip). Needs root (or sudo) only if something is missing.
 set -euo pipefail
 packages=(build-essential cmake ninja-build ccache git xz-utils ca-certificates
-          libopenmpi-dev openmpi-bin libfftw3-dev libeigen3-dev voro++-dev
+          libopenmpi-dev openmpi-bin libfftw3-dev libeigen3-dev voro++-dev libpng-dev
           libgtest-dev libgmock-dev libbenchmark-dev
-          python3 python3-numpy python3-scipy python3-matplotlib python3-pytest)
+          python3 python3-numpy python3-scipy python3-matplotlib python3-pytest
+          python3-pandas python3-tqdm python3-venv python3-pip python3-setuptools)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -63,7 +63,7 @@ void GranSubModTwistingMarshallJKR::init()
    value that produces exactly M_crit (as the sliding model does).
 ------------------------------------------------------------------------- */
 
-void GranSubModTwistingMarshallJKR::calculate_forces()
+GC_TWISTING_RESULT GranSubModTwistingMarshallJKR::calculate_forces()
 {
   const double a = gm->contact_radius;
   const double k = 0.5 * k_tang * a * a * a;
@@ -79,6 +79,9 @@ void GranSubModTwistingMarshallJKR::calculate_forces()
     moment = (moment > 0.0) ? Mcrit : -Mcrit;
     angle = (k > 0.0) ? -(moment + damp * gm->magtwist) / k : 0.0;
   }
-  gm->magtortwist = moment;
   if (gm->history_update) phi = angle;
+  gm->magtortwist = moment;
+#if GC_TWISTING_RETURNS_MOMENT
+  return moment;
+#endif
 }

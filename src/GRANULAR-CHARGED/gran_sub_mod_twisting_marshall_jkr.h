@@ -18,6 +18,16 @@ GranSubModStyle(marshall/jkr,GranSubModTwistingMarshallJKR,TWISTING);
 
 #include "gran_sub_mod_twisting.h"
 
+// LAMMPS 4Jul2026 returns the twisting moment from calculate_forces(); 4Feb2025 stores it in
+// GranularModel::magtortwist. GC_TWISTING_RETURNS_MOMENT comes from cmake/LammpsSource.cmake.
+#ifndef GC_TWISTING_RETURNS_MOMENT
+#error "GC_TWISTING_RETURNS_MOMENT is set by the GRANULAR-CHARGED CMake build"
+#elif GC_TWISTING_RETURNS_MOMENT
+#define GC_TWISTING_RESULT double
+#else
+#define GC_TWISTING_RESULT void
+#endif
+
 namespace LAMMPS_NS {
 namespace Granular_NS {
 
@@ -27,7 +37,7 @@ namespace Granular_NS {
    public:
     GranSubModTwistingMarshallJKR(class GranularModel *, class LAMMPS *);
     void init() override;
-    void calculate_forces() override;
+    GC_TWISTING_RESULT calculate_forces() override;
 
    protected:
     double k_tang;     // 8 G*: tangential stiffness per unit contact radius
