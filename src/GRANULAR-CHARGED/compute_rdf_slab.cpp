@@ -34,7 +34,7 @@
 #include "neigh_request.h"
 #include "neighbor.h"
 #include "pair.h"
-#include "slab_bounds.h"
+#include "slab_geometry.h"
 #include "update.h"
 
 #include <cmath>
@@ -42,16 +42,6 @@
 
 using namespace LAMMPS_NS;
 using MathConst::MY_PI;
-
-static constexpr double BIG = 1.0e300;
-
-// volume of the part of a ball of radius r beyond a plane at distance d >= 0 from its centre
-static inline double cap_volume(double r, double d)
-{
-  if (d >= r) return 0.0;
-  const double h = r - d;
-  return MY_PI * h * h * (2.0 * r + d) / 3.0;
-}
 
 /* ---------------------------------------------------------------------- */
 
@@ -92,7 +82,7 @@ ComputeRDFSlab::ComputeRDFSlab(LAMMPS *lmp, int narg, char **arg) :
     } else
       error->all(FLERR, iarg, "Unknown compute rdf/slab keyword: {}", arg[iarg]);
   }
-  check_box();
+  check_slab_box(lmp, "Compute rdf/slab");
 
   array_flag = 1;
   size_array_rows = nbin;
@@ -122,20 +112,9 @@ ComputeRDFSlab::~ComputeRDFSlab()
 
 /* ---------------------------------------------------------------------- */
 
-void ComputeRDFSlab::check_box()
-{
-  if (!domain->xperiodic || !domain->yperiodic)
-    error->all(FLERR, "Compute rdf/slab requires a box periodic in x and y, boundary is {} {} {}",
-               domain->xperiodic ? "p" : "non-periodic", domain->yperiodic ? "p" : "non-periodic",
-               domain->zperiodic ? "p" : "non-periodic");
-  if (domain->dimension != 3) error->all(FLERR, "Compute rdf/slab requires a 3d system");
-}
-
-/* ---------------------------------------------------------------------- */
-
 void ComputeRDFSlab::init()
 {
-  check_box();
+  check_slab_box(lmp, "Compute rdf/slab");
 
   // length unit: the mean diameter of the group's atoms at the start of the run
 
@@ -162,7 +141,8 @@ void ComputeRDFSlab::init()
   // occasional half list out to rmax + skin, kept until the next reneighboring as
   // compute rdf does; atoms beyond rmax + skin - (pair cutoff) need ghost atoms of their own
 
-  if ((neighbor->style == Neighbor::MULTI) || (neighbor->style == Neighbor::MULTI_OLD))
+  // (4Feb2025 also has MULTI_OLD, 4Jul2026 does not: test for what is supported)
+  if (neighbor->style != Neighbor::BIN && neighbor->style != Neighbor::NSQ)
     error->all(FLERR, "Compute rdf/slab requires neighbor style 'bin' or 'nsq'");
   const double skin = neighbor->skin;
   const double mycutneigh = rmax + skin;
@@ -212,16 +192,16 @@ void ComputeRDFSlab::compute_array()
 
   double lo = zlo, hi = zhi;
   if (zlo_null || zhi_null) {
-    double ext[2] = {-BIG, -BIG}, extall[2];
+    double lowest = HUGE_VAL, highest = -HUGE_VAL;
     for (int i = 0; i < nlocal; i++)
       if (mask[i] & groupbit) {
         const double z = x[i][2] - shift(x[i][2]);
-        ext[0] = MAX(ext[0], -z);
-        ext[1] = MAX(ext[1], z);
+        lowest = MIN(lowest, z);
+        highest = MAX(highest, z);
       }
-    MPI_Allreduce(ext, extall, 2, MPI_DOUBLE, MPI_MAX, world);
-    if (zlo_null) lo = -extall[0];
-    if (zhi_null) hi = extall[1];
+    reduce_z_range(world, lowest, highest, lowest, highest);
+    if (zlo_null) lo = lowest;
+    if (zhi_null) hi = highest;
   }
   if (zper && (lo < domain->boxlo[2] || hi > domain->boxhi[2]))
     error->all(FLERR, Error::NOLASTLINE,
@@ -284,7 +264,7 @@ void ComputeRDFSlab::compute_array()
       for (const double d : {z - lo, hi - z}) {
         if (d >= rmax) continue;
         for (int k = static_cast<int>(d * delrinv) + 1; k <= nbin; k++)
-          capsum[k] += cap_volume(k * delr, d);
+          capsum[k] += sphere_cap_volume(k * delr, d);
       }
     }
   }
