@@ -31,7 +31,7 @@
 #include "neigh_list.h"
 #include "neighbor.h"
 #include "pair.h"
-#include "slab_bounds.h"
+#include "slab_geometry.h"
 #include "update.h"
 
 #include <cmath>
@@ -48,7 +48,7 @@ ComputeCoordDist::ComputeCoordDist(LAMMPS *lmp, int narg, char **arg) :
   if (!atom->radius_flag)
     error->all(FLERR, "Compute coord/dist requires atom style sphere (per-atom radius)");
 
-  zmax = 20;
+  max_coord = 20;
   zlo_null = zhi_null = 1;
   zlo = zhi = 0.0;
   active = 0;
@@ -81,9 +81,9 @@ ComputeCoordDist::ComputeCoordDist(LAMMPS *lmp, int narg, char **arg) :
       iarg += 2;
     } else if (strcmp(arg[iarg], "zmax") == 0) {
       if (iarg + 2 > narg) utils::missing_cmd_args(FLERR, "compute coord/dist zmax", error);
-      zmax = utils::inumeric(FLERR, arg[iarg + 1], false, lmp);
-      if (zmax < 1 || zmax > 10000)
-        error->all(FLERR, iarg + 1, "Compute coord/dist zmax must be in [1, 10000], got {}", zmax);
+      max_coord = utils::inumeric(FLERR, arg[iarg + 1], false, lmp);
+      if (max_coord < 1 || max_coord > 10000)
+        error->all(FLERR, iarg + 1, "Compute coord/dist zmax must be in [1, 10000], got {}", max_coord);
       iarg += 2;
     } else
       error->all(FLERR, iarg, "Unknown compute coord/dist keyword: {}", arg[iarg]);
@@ -94,7 +94,7 @@ ComputeCoordDist::ComputeCoordDist(LAMMPS *lmp, int narg, char **arg) :
   scalar_flag = 1;
   extscalar = 0;
   array_flag = 1;
-  size_array_rows = zmax + 1;
+  size_array_rows = max_coord + 1;
   size_array_cols = 3;
   extarray = 0;
   peratom_flag = 1;
@@ -103,10 +103,10 @@ ComputeCoordDist::ComputeCoordDist(LAMMPS *lmp, int narg, char **arg) :
 
   nmax = 0;
   tally_step = -1;
-  memory->create(tally, zmax + 3, "coord/dist:tally");
-  memory->create(array, zmax + 1, 3, "coord/dist:array");
-  for (int z = 0; z <= zmax; z++) array[z][0] = array[z][1] = array[z][2] = 0.0;
-  for (int z = 0; z <= zmax; z++) array[z][0] = z;
+  memory->create(tally, max_coord + 3, "coord/dist:tally");
+  memory->create(array, max_coord + 1, 3, "coord/dist:array");
+  for (int z = 0; z <= max_coord; z++) array[z][0] = array[z][1] = array[z][2] = 0.0;
+  for (int z = 0; z <= max_coord; z++) array[z][0] = z;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -249,8 +249,8 @@ void ComputeCoordDist::tally_global()
   if (invoked_peratom != update->ntimestep) compute_peratom();
   tally_step = update->ntimestep;
 
-  double *local = new double[zmax + 3];
-  for (int k = 0; k < zmax + 3; k++) local[k] = 0.0;
+  double *local = new double[max_coord + 3];
+  for (int k = 0; k < max_coord + 3; k++) local[k] = 0.0;
   double **x = atom->x;
   int *mask = atom->mask;
   const int nlocal = atom->nlocal;
@@ -263,11 +263,11 @@ void ComputeCoordDist::tally_global()
     if (!zlo_null && zi < zlo) continue;
     if (!zhi_null && zi > zhi) continue;
     const int nc = static_cast<int>(coord[i]);
-    local[nc < zmax ? nc : zmax] += 1.0;
-    local[zmax + 1] += coord[i];
-    local[zmax + 2] += 1.0;
+    local[nc < max_coord ? nc : max_coord] += 1.0;
+    local[max_coord + 1] += coord[i];
+    local[max_coord + 2] += 1.0;
   }
-  MPI_Allreduce(local, tally, zmax + 3, MPI_DOUBLE, MPI_SUM, world);
+  MPI_Allreduce(local, tally, max_coord + 3, MPI_DOUBLE, MPI_SUM, world);
   delete[] local;
 }
 
@@ -277,8 +277,8 @@ double ComputeCoordDist::compute_scalar()
 {
   invoked_scalar = update->ntimestep;
   tally_global();
-  const double n = tally[zmax + 2];
-  scalar = (n > 0.0) ? tally[zmax + 1] / n : 0.0;
+  const double n = tally[max_coord + 2];
+  scalar = (n > 0.0) ? tally[max_coord + 1] / n : 0.0;
   return scalar;
 }
 
@@ -288,8 +288,8 @@ void ComputeCoordDist::compute_array()
 {
   invoked_array = update->ntimestep;
   tally_global();
-  const double n = tally[zmax + 2];
-  for (int z = 0; z <= zmax; z++) {
+  const double n = tally[max_coord + 2];
+  for (int z = 0; z <= max_coord; z++) {
     array[z][0] = z;
     array[z][1] = tally[z];
     array[z][2] = (n > 0.0) ? tally[z] / n : 0.0;
@@ -316,6 +316,6 @@ void ComputeCoordDist::unpack_reverse_comm(int n, int *list, double *buf)
 
 double ComputeCoordDist::memory_usage()
 {
-  return (double) nmax * sizeof(double) + (double) (zmax + 3) * sizeof(double) +
-      (double) (zmax + 1) * 3 * sizeof(double);
+  return (double) nmax * sizeof(double) + (double) (max_coord + 3) * sizeof(double) +
+      (double) (max_coord + 1) * 3 * sizeof(double);
 }

@@ -36,7 +36,8 @@ class ComputeCoordDist : public Compute {
   double memory_usage() override;
 
  private:
-  int zmax;                  // largest Z with its own row of f(Z); the last row counts Z >= zmax
+  int max_coord;    // largest coordination number with its own row of f(Z) (keyword zmax);
+                    // the last row counts every Z >= max_coord
   double zlo, zhi;           // slab of atom centres that enter f(Z) and <Z>
   int zlo_null, zhi_null;    // 1 if that bound is NULL (unbounded: the bed's own extent)
   int active;                // 1: contacts held by the granular pair style, 0: geometric

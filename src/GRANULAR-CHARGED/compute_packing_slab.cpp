@@ -13,7 +13,9 @@
    counted whole by its owner), V = 4/3 pi R^3 - cap(R, z - zlo) - cap(R, zhi - z)
    with cap(R, d) = pi (R - d)^2 (2 R + d) / 3 the part of the ball beyond a
    plane at signed distance d from its centre (0 for d >= R, the whole ball
-   for d <= -R). With z periodic, every image z + n Lz is included.
+   for d <= -R). With z periodic, every image z + n Lz is included: a slab thicker than Lz
+   holds k = floor((zhi - zlo) / Lz) whole periods (every sphere k times, whole) plus a
+   remainder slab thinner than Lz, so the cost per atom stays O(1) for any slab.
 ------------------------------------------------------------------------- */
 
 #include "compute_packing_slab.h"
@@ -22,7 +24,7 @@
 #include "domain.h"
 #include "error.h"
 #include "math_const.h"
-#include "slab_bounds.h"
+#include "slab_geometry.h"
 #include "update.h"
 
 #include <cmath>
@@ -30,17 +32,6 @@
 
 using namespace LAMMPS_NS;
 using MathConst::MY_PI;
-
-static constexpr double BIG = 1.0e300;
-
-// volume of the part of a ball of radius r beyond a plane at signed distance d from its centre
-static inline double cap_volume(double r, double d)
-{
-  if (d >= r) return 0.0;
-  if (d <= -r) return 4.0 * MY_PI / 3.0 * r * r * r;
-  const double h = r - d;
-  return MY_PI * h * h * (2.0 * r + d) / 3.0;
-}
 
 /* ---------------------------------------------------------------------- */
 
@@ -52,7 +43,7 @@ ComputePackingSlab::ComputePackingSlab(LAMMPS *lmp, int narg, char **arg) : Comp
   if (narg > 5) error->all(FLERR, 5, "Unknown compute packing/slab keyword: {}", arg[5]);
 
   parse_slab_bounds(lmp, arg, 3, "Compute packing/slab", zlo, zhi, zlo_null, zhi_null);
-  check_box();
+  check_slab_box(lmp, "Compute packing/slab");
 
   scalar_flag = 1;
   extscalar = 0;
@@ -66,21 +57,9 @@ ComputePackingSlab::ComputePackingSlab(LAMMPS *lmp, int narg, char **arg) : Comp
 
 /* ---------------------------------------------------------------------- */
 
-void ComputePackingSlab::check_box()
-{
-  if (!domain->xperiodic || !domain->yperiodic)
-    error->all(FLERR,
-               "Compute packing/slab requires a box periodic in x and y, boundary is {} {} {}",
-               domain->xperiodic ? "p" : "non-periodic", domain->yperiodic ? "p" : "non-periodic",
-               domain->zperiodic ? "p" : "non-periodic");
-  if (domain->dimension != 3) error->all(FLERR, "Compute packing/slab requires a 3d system");
-}
-
-/* ---------------------------------------------------------------------- */
-
 void ComputePackingSlab::init()
 {
-  check_box();
+  check_slab_box(lmp, "Compute packing/slab");
   result_step = -1;
 }
 
@@ -100,21 +79,29 @@ void ComputePackingSlab::tally()
 
   double lo = zlo, hi = zhi;
   if (zlo_null || zhi_null) {
-    double ext[2] = {-BIG, -BIG}, extall[2];
+    double bottom = HUGE_VAL, top = -HUGE_VAL;
     for (int i = 0; i < nlocal; i++)
       if (mask[i] & groupbit) {
-        ext[0] = MAX(ext[0], -(x[i][2] - radius[i]));
-        ext[1] = MAX(ext[1], x[i][2] + radius[i]);
+        bottom = MIN(bottom, x[i][2] - radius[i]);
+        top = MAX(top, x[i][2] + radius[i]);
       }
-    MPI_Allreduce(ext, extall, 2, MPI_DOUBLE, MPI_MAX, world);
-    if (zlo_null) lo = -extall[0];
-    if (zhi_null) hi = extall[1];
+    reduce_z_range(world, bottom, top, bottom, top);
+    if (zlo_null) lo = bottom;
+    if (zhi_null) hi = top;
   }
 
-  // images of a sphere in a periodic z: every z + n Lz that can reach the slab
+  // periodic z: k whole periods, each holding every sphere once, and the remainder slab
+  // [rlo, rlo + rest] (rest < Lz) in the images z + n Lz that can reach it
 
   const int zper = domain->zperiodic;
   const double lz = domain->zprd;
+  double periods = 0.0, rlo = lo, rhi = hi;
+  if (zper && hi > lo) {
+    periods = floor((hi - lo) / lz);
+    rlo = domain->boxlo[2] + fmod(lo - domain->boxlo[2], lz);
+    if (rlo < domain->boxlo[2]) rlo += lz;
+    rhi = rlo + MAX(0.0, (hi - lo) - periods * lz);
+  }
 
   double loc[2] = {0.0, 0.0}, all[2];
   if (hi > lo) {
@@ -123,16 +110,16 @@ void ComputePackingSlab::tally()
       const double r = radius[i];
       if (r <= 0.0) continue;
       const double full = 4.0 * MY_PI / 3.0 * r * r * r;
-      int nlo = 0, nhi = 0;
+      double nlo = 0.0, nhi = 0.0;
       if (zper) {
-        nlo = static_cast<int>(floor((lo - r - x[i][2]) / lz));
-        nhi = static_cast<int>(ceil((hi + r - x[i][2]) / lz));
+        nlo = floor((rlo - r - x[i][2]) / lz);
+        nhi = ceil((rhi + r - x[i][2]) / lz);
       }
-      double v = 0.0;
-      for (int n = nlo; n <= nhi; n++) {
+      double v = periods * full;
+      for (double n = nlo; n <= nhi; n += 1.0) {
         const double z = x[i][2] + n * lz;
-        if (z + r <= lo || z - r >= hi) continue;
-        v += MAX(0.0, full - cap_volume(r, z - lo) - cap_volume(r, hi - z));
+        if (z + r <= rlo || z - r >= rhi) continue;
+        v += MAX(0.0, full - sphere_cap_volume(r, z - rlo) - sphere_cap_volume(r, rhi - z));
       }
       if (v > 0.0) {
         loc[0] += v;

@@ -36,7 +36,6 @@ class ComputePackingSlab : public Compute {
   double result[3];          // phi, # of atoms whose sphere intersects the slab, slab volume
   bigint result_step;        // timestep of result (-1: none)
 
-  void check_box();
   void tally();
 };
 

@@ -45,7 +45,6 @@ class ComputeRDFSlab : public Compute {
       *bufall;    // local and global tallies: hist[nbin], count[nbin], capsum[nbin+1], nref
   class NeighList *list;    // occasional half list with cutoff rmax + skin
 
-  void check_box();
 };
 
 }    // namespace LAMMPS_NS

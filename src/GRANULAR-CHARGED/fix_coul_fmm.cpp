@@ -14,7 +14,10 @@
 #include "domain.h"
 #include "error.h"
 #include "force.h"
+#include "group.h"
 #include "memory.h"
+#include "modify.h"
+#include "respa.h"
 #include "update.h"
 
 #include "gcfmm/options.hpp"
@@ -38,6 +41,9 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
 {
   scalar_flag = 1;
   extscalar = 1;
+  vector_flag = 1;    // solver diagnostics: estimated error, order, M2L and P2P counts
+  size_vector = 4;
+  extvector = 0;
   global_freq = 1;
   energy_global_flag = 1;
   virial_global_flag = virial_peratom_flag = 1;
@@ -45,6 +51,8 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
   size_peratom_cols = 4;
   peratom_freq = 1;
   dynamic_group_allow = 1;
+  respa_level_support = 1;
+  ilevel_respa = 0;
   create_attribute = 1;    // atoms created by other fixes get a zero stored field (set_arrays)
 
   opts->accuracy = 1e-4;
@@ -149,7 +157,7 @@ FixCoulFMM::~FixCoulFMM()
 
 int FixCoulFMM::setmask()
 {
-  return POST_FORCE | MIN_POST_FORCE;
+  return POST_FORCE | POST_FORCE_RESPA | MIN_POST_FORCE;
 }
 
 /* ----------------------------------------------------------------------
@@ -159,6 +167,9 @@ int FixCoulFMM::setmask()
 void FixCoulFMM::init()
 {
   if (!atom->q_flag) error->all(FLERR, "Fix coul/fmm requires an atom style with charge (q)");
+  // results are matched to atoms by ID; without IDs every atom would get atom 1's field
+  if (!atom->tag_enable)
+    error->all(FLERR, "Fix coul/fmm requires atom IDs (atom_modify id yes)");
   if (domain->dimension != 3) error->all(FLERR, "Fix coul/fmm requires a 3d simulation");
   if (domain->triclinic) error->all(FLERR, "Fix coul/fmm does not support triclinic boxes");
   const int px = domain->xperiodic, py = domain->yperiodic, pz = domain->zperiodic;
@@ -176,6 +187,21 @@ void FixCoulFMM::init()
     error->warning(FLERR,
                    "Fix coul/fmm is used together with a kspace style: Coulomb "
                    "interactions may be counted twice");
+  if (bed_given && !(opts->boundary == gcfmm::Boundary::Periodic2D &&
+                     opts->farfield == gcfmm::FarField::Average))
+    error->all(FLERR,
+               "Fix coul/fmm keyword bed applies only to farfield average with boundary p p f");
+  if (thermo_virial && opts->boundary == gcfmm::Boundary::Periodic2D && comm->me == 0)
+    error->warning(FLERR,
+                   "Fix coul/fmm {} with boundary p p f contributes only the zz component of the "
+                   "virial (the in-plane components of sum x_i F_i are not the lattice virial)",
+                   id);
+  check_other_coul_fmm_fixes();
+
+  if (utils::strmatch(update->integrate_style, "^respa")) {
+    ilevel_respa = (dynamic_cast<Respa *>(update->integrate))->nlevels - 1;
+    if (respa_level >= 0) ilevel_respa = MIN(respa_level, ilevel_respa);
+  }
   try {
     solver = std::make_unique<gcfmm::Solver>(*opts);
   } catch (std::exception &e) {
@@ -190,18 +216,69 @@ void FixCoulFMM::init()
 void FixCoulFMM::setup(int vflag)
 {
   last_computed = -1;    // always a fresh field at the start of a run (restart-safe)
-  post_force(vflag);
+  if (utils::strmatch(update->integrate_style, "^verlet")) {
+    post_force(vflag);
+  } else {
+    auto *respa = dynamic_cast<Respa *>(update->integrate);
+    respa->copy_flevel_f(ilevel_respa);
+    post_force_respa(vflag, ilevel_respa, 0);
+    respa->copy_f_flevel(ilevel_respa);
+  }
+}
+
+void FixCoulFMM::post_force_respa(int vflag, int ilevel, int /*iloop*/)
+{
+  if (ilevel == ilevel_respa) post_force(vflag);
 }
 
 void FixCoulFMM::min_setup(int vflag)
 {
-  last_computed = -1;
-  post_force(vflag);
+  if (every > 1 && comm->me == 0)
+    error->warning(FLERR,
+                   "Fix coul/fmm {}: every {} is ignored during minimization (a minimizer needs "
+                   "forces and energy of the current positions)",
+                   id, every);
+  min_post_force(vflag);
 }
+
+/* ----------------------------------------------------------------------
+   a line search evaluates several trial positions within one step: always recompute
+------------------------------------------------------------------------- */
 
 void FixCoulFMM::min_post_force(int vflag)
 {
-  post_force(vflag);
+  v_init(vflag);
+  compute_field();
+  last_computed = update->ntimestep;
+  natoms_computed = atom->natoms;
+  apply_field(vflag);
+}
+
+/* ----------------------------------------------------------------------
+   two coul/fmm fixes sharing charged atoms would count their interactions twice; fixes on
+   disjoint groups are allowed, but do not see each other
+------------------------------------------------------------------------- */
+
+void FixCoulFMM::check_other_coul_fmm_fixes()
+{
+  for (auto *other : modify->get_fix_by_style("^coul/fmm$")) {
+    if (other == this) continue;
+    const int both = groupbit | group->bitmask[other->igroup];
+    int shared = 0, shared_all = 0;
+    for (int i = 0; i < atom->nlocal; i++)
+      if ((atom->mask[i] & both) == both && atom->q[i] != 0.0) shared++;
+    MPI_Allreduce(&shared, &shared_all, 1, MPI_INT, MPI_SUM, world);
+    if (shared_all > 0)
+      error->all(FLERR,
+                 "Fix coul/fmm {} and fix coul/fmm {} share {} charged atoms: their Coulomb "
+                 "interactions would be counted twice",
+                 id, other->id, shared_all);
+    if (comm->me == 0)
+      error->warning(FLERR,
+                     "Fix coul/fmm {} and fix coul/fmm {} act on disjoint groups: charges of one "
+                     "group do not interact with those of the other",
+                     id, other->id);
+  }
 }
 
 /* ---------------------------------------------------------------------- */
@@ -361,6 +438,7 @@ void FixCoulFMM::apply_field(int /*vflag*/)
   energy_local = 0.0;
   energy_summed = false;
   double v[6];
+  const bool periodic_xy = opts->boundary == gcfmm::Boundary::Periodic2D;
   for (int i = 0; i < nlocal; i++) {
     if (!(mask[i] & groupbit) || q[i] == 0.0) continue;
     const double fx = q[i] * field[i][0], fy = q[i] * field[i][1], fz = q[i] * field[i][2];
@@ -369,12 +447,15 @@ void FixCoulFMM::apply_field(int /*vflag*/)
     f[i][2] += fz;
     energy_local += 0.5 * q[i] * field[i][3];
     if (evflag) {
-      v[0] = fx * x[i][0];
-      v[1] = fy * x[i][1];
+      // with x and y periodic only the zz term of sum x_i F_i is the virial of the lattice
+      // (image shifts have no z component); the in-plane terms are left out
+      const bool in_plane = !periodic_xy;
+      v[0] = in_plane ? fx * x[i][0] : 0.0;
+      v[1] = in_plane ? fy * x[i][1] : 0.0;
       v[2] = fz * x[i][2];
-      v[3] = fy * x[i][0];
-      v[4] = fz * x[i][0];
-      v[5] = fz * x[i][1];
+      v[3] = in_plane ? fy * x[i][0] : 0.0;
+      v[4] = in_plane ? fz * x[i][0] : 0.0;
+      v[5] = in_plane ? fz * x[i][1] : 0.0;
       v_tally(i, v);
     }
   }
@@ -389,6 +470,29 @@ double FixCoulFMM::compute_scalar()
     energy_summed = true;
   }
   return energy_all;
+}
+
+/* ----------------------------------------------------------------------
+   1: estimated relative RMS force error, 2: expansion order, 3: M2L interactions,
+   4: particle pairs summed directly (all of the last evaluation, the same on every rank)
+------------------------------------------------------------------------- */
+
+double FixCoulFMM::compute_vector(int n)
+{
+  if (!solver) return 0.0;
+  const auto &st = solver->stats();
+  switch (n) {
+    case 0:
+      return st.estimated_error;
+    case 1:
+      return st.order;
+    case 2:
+      return (double) st.m2l_count;
+    case 3:
+      return (double) st.p2p_pairs;
+    default:
+      return 0.0;
+  }
 }
 
 /* ---------------------------------------------------------------------- */

@@ -39,8 +39,10 @@ class FixCoulFMM : public Fix {
   void setup(int) override;
   void min_setup(int) override;
   void post_force(int) override;
+  void post_force_respa(int, int, int) override;
   void min_post_force(int) override;
   double compute_scalar() override;
+  double compute_vector(int) override;
   double memory_usage() override;
 
   void grow_arrays(int) override;
@@ -66,6 +68,9 @@ class FixCoulFMM : public Fix {
   std::vector<double> result;    // potential, Ex, Ey, Ez of the gathered atoms, n each
   std::vector<tagint> gtag;
 
+  int ilevel_respa;    // rRESPA level at which the Coulomb force is applied (outermost)
+
+  void check_other_coul_fmm_fixes();
   void compute_field();
   void apply_field(int vflag);
   void gather_charges();

@@ -9,6 +9,8 @@
 
 #include "gran_sub_mod_normal_jkr_marshall.h"
 
+#include "gran_sub_mod_damping_marshall.h"
+
 #include "citeme.h"
 #include "error.h"
 #include "granular_model.h"
@@ -96,6 +98,21 @@ void GranSubModNormalJKRMarshall::mix_coeffs(double *icoeffs, double *jcoeffs)
   coeffs[3] = mix_geom(icoeffs[3], jcoeffs[3]);
   mixed_coefficients = 1;
   coeffs_to_local();
+}
+
+/* ----------------------------------------------------------------------
+   the second coefficient is a restitution coefficient, which only damping marshall reads as
+   such: every other damping model would take e (through get_damp()) as its own damping
+   constant and silently give other collisions (e.g. elastic ones for viscoelastic)
+------------------------------------------------------------------------- */
+
+void GranSubModNormalJKRMarshall::init()
+{
+  if (!dynamic_cast<GranSubModDampingMarshall *>(gm->damping_model))
+    error->all(FLERR,
+               "Normal model jkr/marshall requires damping marshall (its second coefficient is "
+               "the restitution coefficient that only damping marshall uses), got damping {}",
+               gm->damping_model->name);
 }
 
 /* ---------------------------------------------------------------------- */

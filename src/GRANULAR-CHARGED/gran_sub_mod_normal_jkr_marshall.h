@@ -30,6 +30,7 @@ namespace Granular_NS {
     GranSubModNormalJKRMarshall(class GranularModel *, class LAMMPS *);
     void coeffs_to_local() override;
     void mix_coeffs(double *, double *) override;
+    void init() override;
     bool touch() override;
     double pulloff_distance(double, double) override;
     double calculate_forces() override;

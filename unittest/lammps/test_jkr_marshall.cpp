@@ -393,6 +393,12 @@ TEST(JKRMarshall, BadInput)
                "marshall rolling model, theta_crit must be > 0, got 0");
   expect_match(err("jkr 2e8 0.7 0.33 0.01 damping marshall tangential marshall 0.3"),
                "Damping marshall requires normal model jkr/marshall.*not jkr");
+  // e is a restitution coefficient: any damping model but marshall would misread it
+  for (const char *d : {"viscoelastic", "velocity", "mass_velocity"})    // LAMMPS refuses tsuji itself
+    expect_match(err(fmt::format("jkr/marshall 2e8 0.7 0.33 0.01 damping {} tangential marshall 0.3", d)),
+                 fmt::format("jkr/marshall requires damping marshall.*got damping {}", d));
+  expect_match(err("jkr/marshall 2e8 0.7 0.33 0.01 tangential marshall 0.3"),
+               "jkr/marshall requires damping marshall|Must specify damping");
   expect_match(err("hertz/material 2e8 0.7 0.33 damping viscoelastic tangential marshall 0.3 "
                    "rolling marshall 0.01"),
                "Rolling marshall requires normal model jkr/marshall");

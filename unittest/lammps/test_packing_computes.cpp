@@ -440,9 +440,17 @@ TEST(PackingComputes, PeriodicZ)
           fmt::format("compute phi1 all packing/slab {:.17g} {:.17g}", -0.3123 * a, 2.6877 * a),
           fmt::format("compute phi2 all packing/slab {:.17g} {:.17g}", 4.1 * a, 7.1 * a),
           fmt::format("compute phi3 all packing/slab 0 {:.17g}", 6 * a),
+          // far more periods than a loop over images could visit (2e10 / (6 a) ~ 2e9 each way):
+          // whole periods count each sphere once, the remainder slab is a few images
+          "compute phihuge all packing/slab -1e10 1e10",
+          fmt::format("compute phimany all packing/slab {:.17g} {:.17g}", -0.3123 * a, (6 * 7 + 2.6877) * a),
           "compute g all rdf/slab 30 2.1 units diameter", "run 0"});
   EXPECT_DOUBLE_EQ(cscalar(l, "z"), 12.0);
   for (const char *id : {"phi1", "phi2", "phi3"}) EXPECT_NEAR(cscalar(l, id), FCC.phi, 1e-9) << id;
+  // 7.5 periods: 7 whole ones plus half a period, which holds the bulk phi as well (any 3 a
+  // of FCC (001) do); round-off of a slab of 2e10 is ~1e-16 relative
+  EXPECT_NEAR(cscalar(l, "phimany"), FCC.phi, 1e-9);
+  EXPECT_NEAR(cscalar(l, "phihuge"), FCC.phi, 1e-9);
   auto g = carray(l, "g", 30, 3);
   EXPECT_NEAR(g[14][2], 12.0, 1e-12);    // bin of r = 1
   EXPECT_NEAR(g[20][2], 18.0, 1e-12);    // sqrt 2
