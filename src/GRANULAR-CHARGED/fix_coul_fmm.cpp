@@ -17,6 +17,9 @@
 #include "group.h"
 #include "memory.h"
 #include "modify.h"
+#include "neigh_list.h"
+#include "neigh_request.h"
+#include "neighbor.h"
 #include "respa.h"
 #include "update.h"
 
@@ -35,9 +38,10 @@ using namespace FixConst;
 /* ---------------------------------------------------------------------- */
 
 FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), opts(new gcfmm::Options), every(1), last_computed(-1), natoms_computed(-1),
-    bed_given(false), energy_local(0.0), energy_all(0.0), energy_summed(false), field(nullptr),
-    logged(false)
+    Fix(lmp, narg, arg), opts(new gcfmm::Options), solver_boundary(-1), every(1), near_cutoff(0.0), last_computed(-1),
+    natoms_computed(-1), box_computed{0.0, 0.0, 0.0, 0.0}, bed_given(false), energy_local(0.0),
+    energy_all(0.0), energy_summed(false), field(nullptr), eval_state(nullptr),
+    near_delta(nullptr), nmax_ghost(0), list(nullptr), logged(false)
 {
   scalar_flag = 1;
   extscalar = 1;
@@ -54,6 +58,9 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
   respa_level_support = 1;
   ilevel_respa = 0;
   create_attribute = 1;    // atoms created by other fixes get a zero stored field (set_arrays)
+  restart_global = 1;      // the evaluation schedule and the stored field survive a restart
+  restart_peratom = 1;
+  comm_forward = 3;        // displacements since the last evaluation, for the near refresh
 
   opts->accuracy = 1e-4;
   opts->images = 1;
@@ -124,6 +131,12 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
       every = utils::inumeric(FLERR, arg[iarg + 1], false, lmp);
       if (every < 1) error->all(FLERR, iarg + 1, "Fix coul/fmm every must be >= 1, got {}", every);
       iarg += 2;
+    } else if (key == "near") {
+      need(1);
+      near_cutoff = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
+      if (!(near_cutoff >= 0.0))
+        error->all(FLERR, iarg + 1, "Fix coul/fmm near cutoff must be >= 0, got {}", arg[iarg + 1]);
+      iarg += 2;
     } else {
       error->all(FLERR, iarg, "Unknown fix coul/fmm keyword: {}", key);
     }
@@ -140,8 +153,8 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
 
   FixCoulFMM::grow_arrays(atom->nmax);
   atom->add_callback(Atom::GROW);
-  for (int i = 0; i < atom->nlocal; i++)
-    for (int k = 0; k < 4; k++) field[i][k] = 0.0;
+  atom->add_callback(Atom::RESTART);
+  for (int i = 0; i < atom->nlocal; i++) FixCoulFMM::set_arrays(i);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -150,7 +163,10 @@ FixCoulFMM::~FixCoulFMM()
 {
   if (copymode) return;
   atom->delete_callback(id, Atom::GROW);
+  atom->delete_callback(id, Atom::RESTART);
   memory->destroy(field);
+  memory->destroy(eval_state);
+  memory->destroy(near_delta);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -202,20 +218,49 @@ void FixCoulFMM::init()
     ilevel_respa = (dynamic_cast<Respa *>(update->integrate))->nlevels - 1;
     if (respa_level >= 0) ilevel_respa = MIN(respa_level, ilevel_respa);
   }
-  try {
-    solver = std::make_unique<gcfmm::Solver>(*opts);
-  } catch (std::exception &e) {
-    error->all(FLERR, "Fix coul/fmm: FMM library: {}", e.what());
+  // the solver (tree memory, far-field operator) is kept across runs; the boundary is the only
+  // option init() can change
+  if (!solver || solver_boundary != (int) opts->boundary) {
+    try {
+      solver = std::make_unique<gcfmm::Solver>(*opts);
+    } catch (std::exception &e) {
+      error->all(FLERR, "Fix coul/fmm: FMM library: {}", e.what());
+    }
+    solver_boundary = (int) opts->boundary;
   }
   logged = false;
-  last_computed = -1;
+
+  // near refresh: a full list of the pairs closer than the near cutoff, ghosts out to it
+  if (near_cutoff > 0.0) {
+    if (every == 1 && comm->me == 0)
+      error->warning(FLERR, "Fix coul/fmm {}: near has no effect with every 1", id);
+    auto *req = neighbor->add_request(this, NeighConst::REQ_FULL);
+    req->set_cutoff(near_cutoff);
+    const double ghost = near_cutoff + neighbor->skin;
+    if (ghost > comm->cutghostuser) {
+      comm->cutghostuser = ghost;
+      if (comm->me == 0)
+        utils::logmesg(lmp, "Fix coul/fmm {}: ghost cutoff raised to {:.6g} for near {:.6g}\n", id,
+                       ghost, near_cutoff);
+    }
+  }
+}
+
+/* ---------------------------------------------------------------------- */
+
+void FixCoulFMM::init_list(int /*id*/, NeighList *ptr)
+{
+  list = ptr;
 }
 
 /* ---------------------------------------------------------------------- */
 
 void FixCoulFMM::setup(int vflag)
 {
-  last_computed = -1;    // always a fresh field at the start of a run (restart-safe)
+  // continue the schedule of the previous run (or of the restart file) when its stored field
+  // still belongs to these atoms, charges and box: a run split into pieces, or continued from
+  // a restart, then evaluates on the same steps as the uninterrupted run
+  if (!stored_field_valid()) last_computed = -1;
   if (utils::strmatch(update->integrate_style, "^verlet")) {
     post_force(vflag);
   } else {
@@ -255,6 +300,27 @@ void FixCoulFMM::min_post_force(int vflag)
 }
 
 /* ----------------------------------------------------------------------
+   the stored field can be continued if it was evaluated for the same number of atoms, box
+   and charges (set between runs changes charges: then evaluate afresh)
+------------------------------------------------------------------------- */
+
+bool FixCoulFMM::stored_field_valid()
+{
+  if (last_computed < 0 || atom->natoms != natoms_computed) return false;
+  if (opts->boundary == gcfmm::Boundary::Periodic2D &&
+      (domain->boxlo[0] != box_computed[0] || domain->boxlo[1] != box_computed[1] ||
+       domain->xprd != box_computed[2] || domain->yprd != box_computed[3]))
+    return false;
+  int changed = 0, changed_all = 0;
+  for (int i = 0; i < atom->nlocal; i++) {
+    const double q = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
+    if (q != eval_state[i][3]) changed = 1;
+  }
+  MPI_Allreduce(&changed, &changed_all, 1, MPI_INT, MPI_MAX, world);
+  return changed_all == 0;
+}
+
+/* ----------------------------------------------------------------------
    two coul/fmm fixes sharing charged atoms would count their interactions twice; fixes on
    disjoint groups are allowed, but do not see each other
 ------------------------------------------------------------------------- */
@@ -287,12 +353,17 @@ void FixCoulFMM::post_force(int vflag)
 {
   v_init(vflag);
   const bigint step = update->ntimestep;
-  // recompute on schedule, and whenever atoms were added or removed (e.g. fix deposit): a new
-  // atom must feel, and exert, the Coulomb force from its first step
-  if (last_computed < 0 || step - last_computed >= every || atom->natoms != natoms_computed) {
+  // evaluate on the steps that are multiples of every (a schedule that does not depend on where
+  // a run starts), and whenever atoms were added or removed (e.g. fix deposit): a new atom must
+  // feel, and exert, the Coulomb force from its first step
+  const bool due = last_computed < 0 || atom->natoms != natoms_computed ||
+      (step % every == 0 && step != last_computed);
+  if (due) {
     compute_field();
     last_computed = step;
     natoms_computed = atom->natoms;
+  } else if (near_cutoff > 0.0) {
+    refresh_near_pairs();
   }
   apply_field(vflag);
 }
@@ -360,8 +431,16 @@ void FixCoulFMM::compute_field()
   gather_charges();
   const size_t n = gtag.size();
   const int nlocal = atom->nlocal;
-  for (int i = 0; i < nlocal; i++)
+  for (int i = 0; i < nlocal; i++) {
     for (int k = 0; k < 4; k++) field[i][k] = 0.0;
+    domain->unmap(atom->x[i], atom->image[i], eval_state[i]);
+    eval_state[i][3] = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
+    for (int k = 4; k < 8; k++) eval_state[i][k] = 0.0;
+  }
+  box_computed[0] = domain->boxlo[0];
+  box_computed[1] = domain->boxlo[1];
+  box_computed[2] = domain->xprd;
+  box_computed[3] = domain->yprd;
   if (n == 0) return;
 
   result.assign(4 * n, 0.0);
@@ -399,10 +478,10 @@ void FixCoulFMM::compute_field()
   for (int i = 0; i < nlocal; i++) {
     if (!(mask[i] & groupbit) || q[i] == 0.0) continue;
     const size_t k = std::lower_bound(gtag.begin(), gtag.end(), tag[i]) - gtag.begin();
-    field[i][0] = c * ex[k];
-    field[i][1] = c * ey[k];
-    field[i][2] = c * ez[k];
-    field[i][3] = c * pot[k];
+    field[i][0] = eval_state[i][4] = c * ex[k];
+    field[i][1] = eval_state[i][5] = c * ey[k];
+    field[i][2] = eval_state[i][6] = c * ez[k];
+    field[i][3] = eval_state[i][7] = c * pot[k];
   }
 
   if (!logged && comm->me == 0) {
@@ -422,6 +501,62 @@ void FixCoulFMM::compute_field()
                    st.estimated_error, opts->accuracy);
   }
   logged = true;
+}
+
+/* ----------------------------------------------------------------------
+   multiple time stepping with a near refresh: between evaluations the field of the pairs
+   closer than the near cutoff follows the atoms, the rest stays as evaluated,
+     E_i(t) = E_i(t_e) + C sum_{j: |r_ij(t)| < rc} q_j [K(r_ij(t)) - K(r_ij(t_e))],  K(r) = r / |r|^3,
+   with r_ij(t_e) = r_ij(t) - (d_i - d_j), d = displacement since the evaluation at t_e (the
+   same for every image of an atom, so periodic images need no special case)
+------------------------------------------------------------------------- */
+
+void FixCoulFMM::refresh_near_pairs()
+{
+  const int nlocal = atom->nlocal, nall = nlocal + atom->nghost;
+  if (nall > nmax_ghost) {
+    nmax_ghost = atom->nmax;
+    memory->destroy(near_delta);
+    memory->create(near_delta, nmax_ghost, 3, "coul/fmm:near_delta");
+  }
+  double **x = atom->x;
+  double xu[3];
+  for (int i = 0; i < nlocal; i++) {
+    domain->unmap(x[i], atom->image[i], xu);
+    for (int k = 0; k < 3; k++) near_delta[i][k] = xu[k] - eval_state[i][k];
+  }
+  comm->forward_comm(this);
+
+  const double c = force->qqrd2e, near_cutsq = near_cutoff * near_cutoff;
+  double *q = atom->q;
+  int *mask = atom->mask;
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    for (int k = 0; k < 4; k++) field[i][k] = eval_state[i][4 + k];
+    if (!(mask[i] & groupbit) || q[i] == 0.0) continue;
+    const int *jlist = list->firstneigh[i];
+    double e[4] = {0.0, 0.0, 0.0, 0.0};
+    for (int jj = 0; jj < list->numneigh[i]; jj++) {
+      const int j = jlist[jj] & NEIGHMASK;
+      if (!(mask[j] & groupbit) || q[j] == 0.0) continue;
+      double now[3], then[3];
+      for (int k = 0; k < 3; k++) {
+        now[k] = x[i][k] - x[j][k];
+        then[k] = now[k] - (near_delta[i][k] - near_delta[j][k]);
+      }
+      // the refreshed pairs are those now closer than the cutoff: a set that depends on the
+      // positions only (not on when the list was built), so split runs agree
+      const double rn2 = now[0] * now[0] + now[1] * now[1] + now[2] * now[2];
+      if (rn2 >= near_cutsq) continue;
+      const double rn = sqrt(rn2);
+      const double rt = sqrt(then[0] * then[0] + then[1] * then[1] + then[2] * then[2]);
+      if (rn == 0.0 || rt == 0.0) continue;    // coincident atoms are caught at evaluations
+      const double sn = q[j] / (rn * rn * rn), st = q[j] / (rt * rt * rt);
+      for (int k = 0; k < 3; k++) e[k] += sn * now[k] - st * then[k];
+      e[3] += q[j] / rn - q[j] / rt;
+    }
+    for (int k = 0; k < 4; k++) field[i][k] += c * e[k];
+  }
 }
 
 /* ----------------------------------------------------------------------
@@ -499,7 +634,7 @@ double FixCoulFMM::compute_vector(int n)
 
 double FixCoulFMM::memory_usage()
 {
-  double bytes = 4.0 * atom->nmax * sizeof(double);
+  double bytes = 12.0 * atom->nmax * sizeof(double) + 3.0 * nmax_ghost * sizeof(double);
   bytes += (double) (gx.capacity() * 9) * sizeof(double);    // gathered atoms and results
   return bytes;
 }
@@ -509,27 +644,104 @@ double FixCoulFMM::memory_usage()
 void FixCoulFMM::grow_arrays(int nmax)
 {
   memory->grow(field, nmax, 4, "coul/fmm:field");
+  memory->grow(eval_state, nmax, 8, "coul/fmm:eval_state");
   array_atom = field;
 }
 
 void FixCoulFMM::copy_arrays(int i, int j, int /*delflag*/)
 {
   for (int k = 0; k < 4; k++) field[j][k] = field[i][k];
+  for (int k = 0; k < 8; k++) eval_state[j][k] = eval_state[i][k];
 }
 
+// a created atom has no stored field; its charge 0 in eval_state marks it as new
 void FixCoulFMM::set_arrays(int i)
 {
   for (int k = 0; k < 4; k++) field[i][k] = 0.0;
+  for (int k = 0; k < 8; k++) eval_state[i][k] = 0.0;
 }
 
 int FixCoulFMM::pack_exchange(int i, double *buf_out)
 {
   for (int k = 0; k < 4; k++) buf_out[k] = field[i][k];
-  return 4;
+  for (int k = 0; k < 8; k++) buf_out[4 + k] = eval_state[i][k];
+  return 12;
 }
 
 int FixCoulFMM::unpack_exchange(int nlocal, double *buf_in)
 {
   for (int k = 0; k < 4; k++) field[nlocal][k] = buf_in[k];
-  return 4;
+  for (int k = 0; k < 8; k++) eval_state[nlocal][k] = buf_in[4 + k];
+  return 12;
+}
+
+int FixCoulFMM::pack_forward_comm(int n, int *list_send, double *buf_out, int /*pbc_flag*/,
+                                  int * /*pbc*/)
+{
+  int m = 0;
+  for (int i = 0; i < n; i++)
+    for (int k = 0; k < 3; k++) buf_out[m++] = near_delta[list_send[i]][k];
+  return m;
+}
+
+void FixCoulFMM::unpack_forward_comm(int n, int first, double *buf_in)
+{
+  int m = 0;
+  for (int i = first; i < first + n; i++)
+    for (int k = 0; k < 3; k++) near_delta[i][k] = buf_in[m++];
+}
+
+/* ----------------------------------------------------------------------
+   restart: the step, atom count and box of the last evaluation (global), the applied and the
+   evaluated field with the evaluation positions and charges (per atom)
+------------------------------------------------------------------------- */
+
+void FixCoulFMM::write_restart(FILE *fp)
+{
+  if (comm->me == 0) {
+    double list_out[7] = {(double) last_computed, (double) natoms_computed, box_computed[0],
+                          box_computed[1],        box_computed[2],          box_computed[3],
+                          (double) every};
+    int size = sizeof(list_out);
+    fwrite(&size, sizeof(int), 1, fp);
+    fwrite(list_out, sizeof(double), 7, fp);
+  }
+}
+
+void FixCoulFMM::restart(char *buf)
+{
+  auto *list_in = (double *) buf;
+  // a different every gives a different schedule: evaluate afresh
+  if ((int) list_in[6] != every) return;
+  last_computed = (bigint) list_in[0];
+  natoms_computed = (bigint) list_in[1];
+  for (int k = 0; k < 4; k++) box_computed[k] = list_in[2 + k];
+}
+
+int FixCoulFMM::pack_restart(int i, double *buf_out)
+{
+  buf_out[0] = 13;    // count first, as atom->extra is shared by the fixes
+  for (int k = 0; k < 4; k++) buf_out[1 + k] = field[i][k];
+  for (int k = 0; k < 8; k++) buf_out[5 + k] = eval_state[i][k];
+  return 13;
+}
+
+void FixCoulFMM::unpack_restart(int nlocal, int nth)
+{
+  double **extra = atom->extra;
+  int m = 0;
+  for (int i = 0; i < nth; i++) m += static_cast<int>(extra[nlocal][m]);
+  m++;
+  for (int k = 0; k < 4; k++) field[nlocal][k] = extra[nlocal][m++];
+  for (int k = 0; k < 8; k++) eval_state[nlocal][k] = extra[nlocal][m++];
+}
+
+int FixCoulFMM::size_restart(int /*nlocal*/)
+{
+  return 13;
+}
+
+int FixCoulFMM::maxsize_restart()
+{
+  return 13;
 }

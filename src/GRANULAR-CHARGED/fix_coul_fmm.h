@@ -36,6 +36,7 @@ class FixCoulFMM : public Fix {
   ~FixCoulFMM() override;
   int setmask() override;
   void init() override;
+  void init_list(int, class NeighList *) override;
   void setup(int) override;
   void min_setup(int) override;
   void post_force(int) override;
@@ -50,17 +51,32 @@ class FixCoulFMM : public Fix {
   void set_arrays(int) override;
   int pack_exchange(int, double *) override;
   int unpack_exchange(int, double *) override;
+  int pack_forward_comm(int, int *, double *, int, int *) override;
+  void unpack_forward_comm(int, int, double *) override;
+  void write_restart(FILE *) override;
+  void restart(char *) override;
+  int pack_restart(int, double *) override;
+  void unpack_restart(int, int) override;
+  int size_restart(int) override;
+  int maxsize_restart() override;
 
  private:
   std::unique_ptr<gcfmm::Options> opts;    // solver options from the keywords
   std::unique_ptr<gcfmm::Solver> solver;
-  int every;                 // recompute every this many steps
+  int solver_boundary;    // the gcfmm::Boundary the solver was made for
+  int every;                 // full evaluation on steps that are multiples of every
+  double near_cutoff;        // pairs closer than this are refreshed every step (0: off)
   bigint last_computed;      // step of the last FMM evaluation (-1: none yet)
   bigint natoms_computed;    // atom count at that evaluation (atoms added -> recompute)
+  double box_computed[4];    // xlo, ylo, xprd, yprd at that evaluation
   bool bed_given;            // bed zlo/zhi given by the user (farfield average)
   double energy_local, energy_all;
   bool energy_summed;
   double **field;    // per atom: Ex, Ey, Ez, potential (force/charge, energy/charge)
+  double **eval_state;    // per atom at the last evaluation: unwrapped x, y, z, charge
+  double **near_delta;    // per atom incl. ghosts: displacement since the last evaluation
+  int nmax_ghost;         // allocated rows of near_delta
+  class NeighList *list;
   bool logged;
 
   // gathered charged atoms of the group, sorted by atom ID (identical on every rank)
@@ -71,7 +87,9 @@ class FixCoulFMM : public Fix {
   int ilevel_respa;    // rRESPA level at which the Coulomb force is applied (outermost)
 
   void check_other_coul_fmm_fixes();
+  bool stored_field_valid();
   void compute_field();
+  void refresh_near_pairs();
   void apply_field(int vflag);
   void gather_charges();
 };

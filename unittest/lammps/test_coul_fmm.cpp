@@ -261,6 +261,7 @@ TEST(CoulFMM, BadInput)
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm images 0"), "farfield exact needs images >= 1");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm farfield maybe"), "farfield must be exact, average or none, got maybe");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm every 0"), "every must be >= 1, got 0");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm near -1"), "near cutoff must be >= 0, got -1");
 }
 
 // per-atom output (Ex, Ey, Ez, phi), every N, fix_modify virial, dielectric
@@ -504,4 +505,67 @@ TEST(CoulFMM, VirialPeriodicOnlyZZ)
   EXPECT_EQ(l.var("c_p[2]"), 0.0);
   EXPECT_EQ(l.var("c_p[4]"), 0.0);
   EXPECT_NE(l.var("c_p[3]"), 0.0);
+}
+
+// ---- multiple time stepping: schedule and near refresh ----
+
+namespace {
+// 200 heavy charges moving at random in a p p m box, `fix` given by the caller
+void moving_charges(Lmp &l, const std::string &boundary = "p p m")
+{
+  random_charges(l, boundary, 200, 20.0, 40.0, 61);
+  l.cmds({"mass 1 1000.0", "velocity all create 300 5 loop geom", "fix nve all nve",
+          "timestep 1.0"});
+}
+}    // namespace
+
+// evaluations fall on multiples of every, whatever the run lengths: a run split at a step
+// that is not a multiple, and one continued from a restart file written there, reproduce the
+// uninterrupted run (before, every N counted from the start of each run)
+TEST(CoulFMM, EveryScheduleIndependentOfRunSplit)
+{
+  const std::string fix = "fix fmm all coul/fmm accuracy 1e-6 every 5 near 6.0";
+  std::vector<double> straight, split, restarted;
+  {
+    Lmp l;
+    moving_charges(l);
+    l.cmds({fix, "run 23 post no"});
+    straight = gather(l, "x", 3);
+  }
+  {
+    Lmp l;
+    moving_charges(l);
+    l.cmds({fix, "run 7 post no", "run 9 post no", "write_restart coul_fmm_every.restart",
+            "run 7 post no"});
+    split = gather(l, "x", 3);
+  }
+  {
+    Lmp l;
+    l.cmds({"read_restart coul_fmm_every.restart", "fix nve all nve", fix, "run 7 post no"});
+    restarted = gather(l, "x", 3);
+  }
+  std::remove("coul_fmm_every.restart");
+  EXPECT_LT(rel_rms(split, straight), 1e-14);
+  EXPECT_LT(rel_rms(restarted, straight), 1e-14);
+}
+
+// near refresh: with a near cutoff beyond the system size in free space every pair is
+// refreshed every step, so the field equals a fresh evaluation although the far part is never
+// re-evaluated (every 1000); without it the frozen field is off by far more
+TEST(CoulFMM, NearRefreshFollowsTheAtoms)
+{
+  auto error_after = [](const std::string &near) {
+    Lmp l;
+    moving_charges(l, "m m m");
+    l.cmds({"fix fmm all coul/fmm accuracy 1e-10 every 1000 " + near, "run 15 post no"});
+    const auto f = gather(l, "f", 3);
+    l.cmds({"unfix fmm", "fix fresh all coul/fmm accuracy 1e-10", "run 0 post no"});
+    return rel_rms(f, gather(l, "f", 3));
+  };
+  const double frozen = error_after(""), refreshed = error_after("near 100.0");
+  std::printf("[ near refresh ] 15 steps after the evaluation: frozen %.3g, near-refreshed %.3g\n",
+              frozen, refreshed);
+  EXPECT_GT(frozen, 1e-6);
+  // the refresh is a direct sum of differences: round-off of the field's cancellations only
+  EXPECT_LT(refreshed, 1e-9);
 }
