@@ -41,12 +41,14 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), opts(new gcfmm::Options), solver_boundary(-1), every(1), near_cutoff(0.0), last_computed(-1),
     natoms_computed(-1), box_computed{0.0, 0.0, 0.0, 0.0}, bed_given(false), energy_local(0.0),
     energy_all(0.0), energy_summed(false), field(nullptr), eval_state(nullptr),
-    near_delta(nullptr), nmax_ghost(0), list(nullptr), logged(false)
+    near_delta(nullptr), nmax_ghost(0), list(nullptr), check_every(0), fresh(nullptr),
+    nmax_check(0), check_last(0.0), check_max(0.0), check_sum2(0.0), check_count(0),
+    logged(false)
 {
   scalar_flag = 1;
   extscalar = 1;
-  vector_flag = 1;    // solver diagnostics: estimated error, order, M2L and P2P counts
-  size_vector = 4;
+  vector_flag = 1;    // diagnostics: solver (error estimate, order, M2L, P2P), MTS check
+  size_vector = 7;
   extvector = 0;
   global_freq = 1;
   energy_global_flag = 1;
@@ -131,6 +133,12 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
       every = utils::inumeric(FLERR, arg[iarg + 1], false, lmp);
       if (every < 1) error->all(FLERR, iarg + 1, "Fix coul/fmm every must be >= 1, got {}", every);
       iarg += 2;
+    } else if (key == "check") {
+      need(1);
+      check_every = utils::inumeric(FLERR, arg[iarg + 1], false, lmp);
+      if (check_every < 0)
+        error->all(FLERR, iarg + 1, "Fix coul/fmm check must be >= 0, got {}", check_every);
+      iarg += 2;
     } else if (key == "near") {
       need(1);
       near_cutoff = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
@@ -167,6 +175,7 @@ FixCoulFMM::~FixCoulFMM()
   memory->destroy(field);
   memory->destroy(eval_state);
   memory->destroy(near_delta);
+  memory->destroy(fresh);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -365,6 +374,7 @@ void FixCoulFMM::post_force(int vflag)
   } else if (near_cutoff > 0.0) {
     refresh_near_pairs();
   }
+  if (check_every > 0 && !due && step % check_every == 0) measure_mts_error();
   apply_field(vflag);
 }
 
@@ -428,19 +438,32 @@ void FixCoulFMM::gather_charges()
 
 void FixCoulFMM::compute_field()
 {
-  gather_charges();
-  const size_t n = gtag.size();
   const int nlocal = atom->nlocal;
   for (int i = 0; i < nlocal; i++) {
-    for (int k = 0; k < 4; k++) field[i][k] = 0.0;
     domain->unmap(atom->x[i], atom->image[i], eval_state[i]);
     eval_state[i][3] = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
-    for (int k = 4; k < 8; k++) eval_state[i][k] = 0.0;
   }
   box_computed[0] = domain->boxlo[0];
   box_computed[1] = domain->boxlo[1];
   box_computed[2] = domain->xprd;
   box_computed[3] = domain->yprd;
+  evaluate_into(eval_state, 4);
+  for (int i = 0; i < nlocal; i++)
+    for (int k = 0; k < 4; k++) field[i][k] = eval_state[i][4 + k];
+}
+
+/* ----------------------------------------------------------------------
+   the FMM field at the current positions: out[i][col .. col+3] = Ex, Ey, Ez, phi (LAMMPS
+   units) for the local atoms, zero for atoms outside the group or uncharged
+------------------------------------------------------------------------- */
+
+void FixCoulFMM::evaluate_into(double **out, int col)
+{
+  gather_charges();
+  const size_t n = gtag.size();
+  const int nlocal = atom->nlocal;
+  for (int i = 0; i < nlocal; i++)
+    for (int k = 0; k < 4; k++) out[i][col + k] = 0.0;
   if (n == 0) return;
 
   result.assign(4 * n, 0.0);
@@ -478,10 +501,10 @@ void FixCoulFMM::compute_field()
   for (int i = 0; i < nlocal; i++) {
     if (!(mask[i] & groupbit) || q[i] == 0.0) continue;
     const size_t k = std::lower_bound(gtag.begin(), gtag.end(), tag[i]) - gtag.begin();
-    field[i][0] = eval_state[i][4] = c * ex[k];
-    field[i][1] = eval_state[i][5] = c * ey[k];
-    field[i][2] = eval_state[i][6] = c * ez[k];
-    field[i][3] = eval_state[i][7] = c * pot[k];
+    out[i][col] = c * ex[k];
+    out[i][col + 1] = c * ey[k];
+    out[i][col + 2] = c * ez[k];
+    out[i][col + 3] = c * pot[k];
   }
 
   if (!logged && comm->me == 0) {
@@ -560,6 +583,37 @@ void FixCoulFMM::refresh_near_pairs()
 }
 
 /* ----------------------------------------------------------------------
+   keyword check: the relative RMS difference between the applied force and the force of a
+   fresh evaluation at the same positions, sqrt(sum q_i^2 |E_i - E_i,fresh|^2 / sum q_i^2
+   |E_i,fresh|^2), i.e. the error that every/near add to the solver's own
+------------------------------------------------------------------------- */
+
+void FixCoulFMM::measure_mts_error()
+{
+  const int nlocal = atom->nlocal;
+  if (nlocal > nmax_check) {
+    nmax_check = atom->nmax;
+    memory->destroy(fresh);
+    memory->create(fresh, nmax_check, 4, "coul/fmm:fresh");
+  }
+  evaluate_into(fresh, 0);
+  double sums[2] = {0.0, 0.0}, all[2];
+  for (int i = 0; i < nlocal; i++) {
+    const double q2 = atom->q[i] * atom->q[i];
+    for (int k = 0; k < 3; k++) {
+      sums[0] += q2 * (field[i][k] - fresh[i][k]) * (field[i][k] - fresh[i][k]);
+      sums[1] += q2 * fresh[i][k] * fresh[i][k];
+    }
+  }
+  MPI_Allreduce(sums, all, 2, MPI_DOUBLE, MPI_SUM, world);
+  const double err = all[1] > 0.0 ? sqrt(all[0] / all[1]) : 0.0;
+  check_last = err;
+  check_max = MAX(check_max, err);
+  check_sum2 += err * err;
+  check_count++;
+}
+
+/* ----------------------------------------------------------------------
    F_i = q_i E_i; energy 1/2 sum q_i phi_i; virial sum x_i F_i (see the doc for its scope)
 ------------------------------------------------------------------------- */
 
@@ -609,11 +663,15 @@ double FixCoulFMM::compute_scalar()
 
 /* ----------------------------------------------------------------------
    1: estimated relative RMS force error, 2: expansion order, 3: M2L interactions,
-   4: particle pairs summed directly (all of the last evaluation, the same on every rank)
+   4: particle pairs summed directly (all of the last evaluation, the same on every rank);
+   keyword check: 5 the last measured MTS error, 6 its largest and 7 its RMS value so far
 ------------------------------------------------------------------------- */
 
 double FixCoulFMM::compute_vector(int n)
 {
+  if (n == 4) return check_last;
+  if (n == 5) return check_max;
+  if (n == 6) return check_count > 0 ? sqrt(check_sum2 / check_count) : 0.0;
   if (!solver) return 0.0;
   const auto &st = solver->stats();
   switch (n) {

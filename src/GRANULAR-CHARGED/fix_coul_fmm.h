@@ -77,6 +77,11 @@ class FixCoulFMM : public Fix {
   double **near_delta;    // per atom incl. ghosts: displacement since the last evaluation
   int nmax_ghost;         // allocated rows of near_delta
   class NeighList *list;
+  int check_every;        // measure the MTS error every this many steps (0: never)
+  double **fresh;         // a fresh evaluation for that measurement
+  int nmax_check;
+  double check_last, check_max, check_sum2;    // measured MTS errors
+  bigint check_count;
   bool logged;
 
   // gathered charged atoms of the group, sorted by atom ID (identical on every rank)
@@ -89,6 +94,8 @@ class FixCoulFMM : public Fix {
   void check_other_coul_fmm_fixes();
   bool stored_field_valid();
   void compute_field();
+  void evaluate_into(double **out, int col);
+  void measure_mts_error();
   void refresh_near_pairs();
   void apply_field(int vflag);
   void gather_charges();

@@ -262,6 +262,7 @@ TEST(CoulFMM, BadInput)
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm farfield maybe"), "farfield must be exact, average or none, got maybe");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm every 0"), "every must be >= 1, got 0");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm near -1"), "near cutoff must be >= 0, got -1");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm check -1"), "check must be >= 0, got -1");
 }
 
 // per-atom output (Ex, Ey, Ez, phi), every N, fix_modify virial, dielectric
@@ -568,4 +569,26 @@ TEST(CoulFMM, NearRefreshFollowsTheAtoms)
   EXPECT_GT(frozen, 1e-6);
   // the refresh is a direct sum of differences: round-off of the field's cancellations only
   EXPECT_LT(refreshed, 1e-9);
+}
+
+// keyword check measures what the test above measures by hand, on every 5th step
+TEST(CoulFMM, CheckMeasuresTheMTSError)
+{
+  auto measured = [](const std::string &near) {
+    Lmp l;
+    moving_charges(l, "m m m");
+    l.cmds({"fix fmm all coul/fmm accuracy 1e-10 every 1000 check 5 " + near, "run 15 post no"});
+    const auto f = gather(l, "f", 3);
+    std::vector<double> m = {l.var("f_fmm[5]"), l.var("f_fmm[6]"), l.var("f_fmm[7]")};
+    l.cmds({"unfix fmm", "fix fresh all coul/fmm accuracy 1e-10", "run 0 post no"});
+    m.push_back(rel_rms(f, gather(l, "f", 3)));    // the error at step 15, by hand
+    return m;
+  };
+  const auto frozen = measured(""), refreshed = measured("near 100.0");
+  std::printf("[ check ] frozen: last %.3g max %.3g rms %.3g (by hand %.3g); refreshed max %.3g\n",
+              frozen[0], frozen[1], frozen[2], frozen[3], refreshed[1]);
+  // the check at step 15 compares with an evaluation at 1e-10: agrees with the hand value
+  EXPECT_NEAR(frozen[0], frozen[3], 1e-6 * frozen[3]);
+  EXPECT_GE(frozen[1], frozen[0]);    // checks at steps 5, 10, 15: the error grows
+  EXPECT_LT(refreshed[1], 1e-9);
 }
