@@ -42,7 +42,7 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
     natoms_computed(-1), box_computed{0.0, 0.0, 0.0, 0.0}, bed_given(false), energy_local(0.0),
     energy_all(0.0), energy_summed(false), field(nullptr), eval_state(nullptr),
     near_delta(nullptr), nmax_ghost(0), list(nullptr), check_every(0), fresh(nullptr),
-    nmax_check(0), check_last(0.0), check_max(0.0), check_sum2(0.0), check_count(0),
+    nmax_check(0), check_last(0.0), check_max(0.0), check_num(0.0), check_den(0.0),
     logged(false)
 {
   scalar_flag = 1;
@@ -408,9 +408,12 @@ void FixCoulFMM::gather_charges()
   std::vector<double> all(total);
   MPI_Allgatherv(buf.data(), mine, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE,
                  world);
+  // results go back to the owners in this rank-block order: 4 values per atom
+  result_counts.resize(nprocs);
+  for (int p = 0; p < nprocs; p++) result_counts[p] = 4 * (counts[p] / 5);
 
   const size_t n = total / 5;
-  std::vector<size_t> order(n);
+  order.resize(n);
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
     return all[5 * a] < all[5 * b];
@@ -490,21 +493,30 @@ void FixCoulFMM::evaluate_into(double **out, int col)
     error->all(FLERR, Error::NOLASTLINE, "Fix coul/fmm: FMM library: {}", failure);
   }
 
-  if (comm->nprocs > 1)
-    MPI_Allreduce(MPI_IN_PLACE, result.data(), 4 * n, MPI_DOUBLE, MPI_SUM, world);
+  // every target was computed by exactly one rank (zero elsewhere): a reduce-scatter in the
+  // order of the gather sums the partitions and hands each rank its own atoms' results only
+  owner_order.resize(4 * n);
+  for (size_t k = 0; k < n; k++) {
+    double *slot = &owner_order[4 * order[k]];
+    slot[0] = ex[k];
+    slot[1] = ey[k];
+    slot[2] = ez[k];
+    slot[3] = pot[k];
+  }
+  own_result.resize(result_counts[comm->me]);
+  MPI_Reduce_scatter(owner_order.data(), own_result.data(), result_counts.data(), MPI_DOUBLE,
+                     MPI_SUM, world);
 
+  // the received block is in the order gather_charges() packed this rank's atoms
   // bare 1/r kernel -> LAMMPS units: qqrd2e includes the dielectric constant
   const double c = force->qqrd2e;
   int *mask = atom->mask;
   double *q = atom->q;
-  tagint *tag = atom->tag;
+  size_t m = 0;
   for (int i = 0; i < nlocal; i++) {
     if (!(mask[i] & groupbit) || q[i] == 0.0) continue;
-    const size_t k = std::lower_bound(gtag.begin(), gtag.end(), tag[i]) - gtag.begin();
-    out[i][col] = c * ex[k];
-    out[i][col + 1] = c * ey[k];
-    out[i][col + 2] = c * ez[k];
-    out[i][col + 3] = c * pot[k];
+    for (int k = 0; k < 4; k++) out[i][col + k] = c * own_result[4 * m + k];
+    m++;
   }
 
   if (!logged && comm->me == 0) {
@@ -609,8 +621,8 @@ void FixCoulFMM::measure_mts_error()
   const double err = all[1] > 0.0 ? sqrt(all[0] / all[1]) : 0.0;
   check_last = err;
   check_max = MAX(check_max, err);
-  check_sum2 += err * err;
-  check_count++;
+  check_num += all[0];
+  check_den += all[1];
 }
 
 /* ----------------------------------------------------------------------
@@ -664,14 +676,16 @@ double FixCoulFMM::compute_scalar()
 /* ----------------------------------------------------------------------
    1: estimated relative RMS force error, 2: expansion order, 3: M2L interactions,
    4: particle pairs summed directly (all of the last evaluation, the same on every rank);
-   keyword check: 5 the last measured MTS error, 6 its largest and 7 its RMS value so far
+   keyword check: 5 the last measured MTS error, 6 the largest, 7 that of all checks together
+   (sums of squares over all checks: weighted by the field, unlike the largest, which a
+   check at a nearly vanishing field can dominate)
 ------------------------------------------------------------------------- */
 
 double FixCoulFMM::compute_vector(int n)
 {
   if (n == 4) return check_last;
   if (n == 5) return check_max;
-  if (n == 6) return check_count > 0 ? sqrt(check_sum2 / check_count) : 0.0;
+  if (n == 6) return check_den > 0.0 ? sqrt(check_num / check_den) : 0.0;
   if (!solver) return 0.0;
   const auto &st = solver->stats();
   switch (n) {
@@ -693,7 +707,7 @@ double FixCoulFMM::compute_vector(int n)
 double FixCoulFMM::memory_usage()
 {
   double bytes = 12.0 * atom->nmax * sizeof(double) + 3.0 * nmax_ghost * sizeof(double);
-  bytes += (double) (gx.capacity() * 9) * sizeof(double);    // gathered atoms and results
+  bytes += (double) (gx.capacity() * 14) * sizeof(double);    // gathered atoms and results
   return bytes;
 }
 

@@ -80,14 +80,18 @@ class FixCoulFMM : public Fix {
   int check_every;        // measure the MTS error every this many steps (0: never)
   double **fresh;         // a fresh evaluation for that measurement
   int nmax_check;
-  double check_last, check_max, check_sum2;    // measured MTS errors
-  bigint check_count;
+  double check_last, check_max;        // measured MTS errors
+  double check_num, check_den;         // their sums of squares over all checks
   bool logged;
 
   // gathered charged atoms of the group, sorted by atom ID (identical on every rank)
   std::vector<double> gx, gy, gz, gq, buf;
-  std::vector<double> result;    // potential, Ex, Ey, Ez of the gathered atoms, n each
+  std::vector<double> result;         // potential, Ex, Ey, Ez of the gathered atoms, n each
   std::vector<tagint> gtag;
+  std::vector<size_t> order;          // sorted position -> position in the gather (rank blocks)
+  std::vector<int> result_counts;     // 4 x atoms of each rank
+  std::vector<double> owner_order;    // Ex, Ey, Ez, phi per atom in gather order
+  std::vector<double> own_result;     // this rank's block of it
 
   int ilevel_respa;    // rRESPA level at which the Coulomb force is applied (outermost)
 
