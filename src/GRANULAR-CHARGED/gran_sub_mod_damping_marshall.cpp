@@ -21,9 +21,16 @@ using namespace Granular_NS;
 /* ---------------------------------------------------------------------- */
 
 GranSubModDampingMarshall::GranSubModDampingMarshall(GranularModel *gm, LAMMPS *lmp) :
-    GranSubModDamping(gm, lmp), jkr(nullptr), alpha(0.0)
+    GranSubModDamping(gm, lmp), jkr(nullptr), alpha(0.0), mass_factor(2.0)
 {
   contact_radius_flag = 1;
+}
+
+GranSubModDampingMarshallPrinted::GranSubModDampingMarshallPrinted(GranularModel *gm,
+                                                                   LAMMPS *lmp) :
+    GranSubModDampingMarshall(gm, lmp)
+{
+  mass_factor = 1.0;
 }
 
 /* ----------------------------------------------------------------------
@@ -62,6 +69,6 @@ void GranSubModDampingMarshall::init()
 double GranSubModDampingMarshall::calculate_forces()
 {
   const double kn = 4.0 / 3.0 * jkr->get_emix() * gm->contact_radius;
-  damp_prefactor = alpha * sqrt(2.0 * gm->meff * (kn > 0.0 ? kn : 0.0));
+  damp_prefactor = alpha * sqrt(mass_factor * gm->meff * (kn > 0.0 ? kn : 0.0));
   return -damp_prefactor * gm->vnnr;
 }

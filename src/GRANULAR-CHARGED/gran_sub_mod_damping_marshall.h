@@ -10,6 +10,7 @@
 #ifdef GRAN_SUB_MOD_CLASS
 // clang-format off
 GranSubModStyle(marshall,GranSubModDampingMarshall,DAMPING);
+GranSubModStyle(marshall/printed,GranSubModDampingMarshallPrinted,DAMPING);
 // clang-format on
 #else
 
@@ -24,7 +25,8 @@ namespace Granular_NS {
   class GranSubModNormalJKRMarshall;
 
   // Normal dashpot of Marshall (2009) for JKR contacts:
-  // eta_N = alpha(e) sqrt(m* k_N), k_N = 4/3 E* a, alpha from the restitution coefficient.
+  // eta_N = alpha(e) sqrt(2 m* k_N), k_N = 4/3 E* a, alpha from the restitution coefficient
+  // (the factor 2 makes a Hertz collision rebound with e; doc/theory.md, damping).
   class GranSubModDampingMarshall : public GranSubModDamping {
    public:
     GranSubModDampingMarshall(class GranularModel *, class LAMMPS *);
@@ -34,6 +36,15 @@ namespace Granular_NS {
    protected:
     GranSubModNormalJKRMarshall *jkr;    // normal model, for E*
     double alpha;                        // alpha(e)
+    double mass_factor;                  // 2: eta_N = alpha sqrt(2 m* k_N); 1: as printed
+  };
+
+  // The same dashpot as printed in the paper (eq. 2) and Marshall (2009): eta_N = alpha(e)
+  // sqrt(m* k_N), which rebounds with more than e (0.778 for e = 0.7 without adhesion).
+  // A convention option for comparisons with the paper, not a correction.
+  class GranSubModDampingMarshallPrinted : public GranSubModDampingMarshall {
+   public:
+    GranSubModDampingMarshallPrinted(class GranularModel *, class LAMMPS *);
   };
 
 }    // namespace Granular_NS

@@ -23,7 +23,7 @@ using namespace MathExtra;
 /* ---------------------------------------------------------------------- */
 
 GranSubModRollingMarshall::GranSubModRollingMarshall(GranularModel *gm, LAMMPS *lmp) :
-    GranSubModRolling(gm, lmp), jkr(nullptr), theta_crit(0.0)
+    GranSubModRolling(gm, lmp), jkr(nullptr), theta_crit(0.0), pair_radius_factor(1.0)
 {
   num_coeffs = 1;
   size_history = 3;
@@ -34,6 +34,13 @@ GranSubModRollingMarshall::GranSubModRollingMarshall(GranularModel *gm, LAMMPS *
   nondefault_history_transfer = 1;
   transfer_history_factor = new double[size_history];
   for (int i = 0; i < size_history; i++) transfer_history_factor[i] = +1.0;
+}
+
+GranSubModRollingMarshallParticle::GranSubModRollingMarshallParticle(GranularModel *gm,
+                                                                     LAMMPS *lmp) :
+    GranSubModRollingMarshall(gm, lmp)
+{
+  pair_radius_factor = 2.0;
 }
 
 /* ----------------------------------------------------------------------
@@ -95,8 +102,10 @@ void GranSubModRollingMarshall::calculate_forces()
     add3(xi, tmp, xi);
   }
 
-  // irreversible rolling beyond theta_crit R
-  const double xi_crit = theta_crit * gm->Reff;
+  // irreversible rolling beyond theta_crit R (R = R_eff, or the particle radius for
+  // marshall/particle: 2 R_eff for a pair, R_eff = r_p at a wall)
+  const double radius = (gm->contact_type == PAIR) ? pair_radius_factor * gm->Reff : gm->Reff;
+  const double xi_crit = theta_crit * radius;
   const double len = len3(xi);
   if (len > xi_crit) scale3(xi_crit / len, xi);
 

@@ -10,6 +10,7 @@
 #ifdef GRAN_SUB_MOD_CLASS
 // clang-format off
 GranSubModStyle(marshall,GranSubModRollingMarshall,ROLLING);
+GranSubModStyle(marshall/particle,GranSubModRollingMarshallParticle,ROLLING);
 // clang-format on
 #else
 
@@ -37,6 +38,16 @@ namespace Granular_NS {
    protected:
     GranSubModNormalJKRMarshall *jkr;    // normal model, for k_R
     double theta_crit;                   // critical rolling angle
+    double pair_radius_factor;           // slip at theta_crit x this x R_eff for a pair
+  };
+
+  // The same spring, but the contact rolls once |xi| exceeds theta_crit times the particle
+  // radius instead of the effective radius: 2 R_eff for a pair (r_p for like spheres, the
+  // harmonic mean of unlike ones), R_eff = r_p at a wall. A convention option: the paper's
+  // eq. 4 writes R without saying which.
+  class GranSubModRollingMarshallParticle : public GranSubModRollingMarshall {
+   public:
+    GranSubModRollingMarshallParticle(class GranularModel *, class LAMMPS *);
   };
 
 }    // namespace Granular_NS
