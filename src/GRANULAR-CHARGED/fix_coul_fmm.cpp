@@ -35,14 +35,24 @@
 using namespace LAMMPS_NS;
 using namespace FixConst;
 
+// per-atom state of the last evaluation (eval_state columns)
+enum : int {
+  EVAL_X = 0,         // unwrapped position at the evaluation (3)
+  EVAL_Q = 3,         // charge at the evaluation (0 outside the group)
+  EVAL_FIELD = 4,     // evaluated Ex, Ey, Ez, phi (4)
+  EVAL_SLOPE = 8,     // change of the far part per step, from the last two evaluations (4)
+  EVAL_COLS = 12
+};
+
 /* ---------------------------------------------------------------------- */
 
 FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), opts(new gcfmm::Options), solver_boundary(-1), every(1), near_cutoff(0.0), last_computed(-1),
+    Fix(lmp, narg, arg), opts(new gcfmm::Options), solver_boundary(-1), every(1), extrapolate(true), near_cutoff(0.0), last_computed(-1),
     natoms_computed(-1), box_computed{0.0, 0.0, 0.0, 0.0}, bed_given(false), energy_local(0.0),
     energy_all(0.0), energy_summed(false), field(nullptr), eval_state(nullptr),
     near_delta(nullptr), nmax_ghost(0), list(nullptr), check_every(0), fresh(nullptr),
     nmax_check(0), check_last(0.0), check_max(0.0), check_num(0.0), check_den(0.0),
+    near_now(nullptr), nmax_near(0),
     logged(false)
 {
   scalar_flag = 1;
@@ -139,6 +149,10 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
       if (check_every < 0)
         error->all(FLERR, iarg + 1, "Fix coul/fmm check must be >= 0, got {}", check_every);
       iarg += 2;
+    } else if (key == "extrapolate") {
+      need(1);
+      extrapolate = utils::logical(FLERR, arg[iarg + 1], false, lmp) == 1;
+      iarg += 2;
     } else if (key == "near") {
       need(1);
       near_cutoff = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
@@ -176,6 +190,7 @@ FixCoulFMM::~FixCoulFMM()
   memory->destroy(eval_state);
   memory->destroy(near_delta);
   memory->destroy(fresh);
+  memory->destroy(near_now);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -302,7 +317,7 @@ void FixCoulFMM::min_setup(int vflag)
 void FixCoulFMM::min_post_force(int vflag)
 {
   v_init(vflag);
-  compute_field();
+  compute_field(false);
   last_computed = update->ntimestep;
   natoms_computed = atom->natoms;
   apply_field(vflag);
@@ -323,7 +338,7 @@ bool FixCoulFMM::stored_field_valid()
   int changed = 0, changed_all = 0;
   for (int i = 0; i < atom->nlocal; i++) {
     const double q = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
-    if (q != eval_state[i][3]) changed = 1;
+    if (q != eval_state[i][EVAL_Q]) changed = 1;
   }
   MPI_Allreduce(&changed, &changed_all, 1, MPI_INT, MPI_MAX, world);
   return changed_all == 0;
@@ -368,11 +383,11 @@ void FixCoulFMM::post_force(int vflag)
   const bool due = last_computed < 0 || atom->natoms != natoms_computed ||
       (step % every == 0 && step != last_computed);
   if (due) {
-    compute_field();
+    compute_field(extrapolate);
     last_computed = step;
     natoms_computed = atom->natoms;
-  } else if (near_cutoff > 0.0) {
-    refresh_near_pairs();
+  } else if (every > 1) {
+    advance_field();
   }
   if (check_every > 0 && !due && step % check_every == 0) measure_mts_error();
   apply_field(vflag);
@@ -439,20 +454,43 @@ void FixCoulFMM::gather_charges()
    so 1 and N ranks agree to the last bit for the same atom order)
 ------------------------------------------------------------------------- */
 
-void FixCoulFMM::compute_field()
+void FixCoulFMM::compute_field(bool with_slope)
 {
   const int nlocal = atom->nlocal;
+  const bigint step = update->ntimestep;
+  // the far part changes smoothly between evaluations of the same atoms: its slope from the
+  // last two evaluations extrapolates it (not across an insertion, a minimizer step or a
+  // changed set of charges). Far part: the field minus that of the pairs now closer than the
+  // near cutoff, for the same pairs at both evaluations (a pair crossing the cutoff would
+  // otherwise enter the slope as a jump): slope = (E(t_e) - E(t_p) - D) / (t_e - t_p) with D
+  // the near-pair difference of the refresh, taken over t_p -> t_e.
+  const bool slope_ok = with_slope && last_computed >= 0 && step > last_computed &&
+      atom->natoms == natoms_computed && stored_field_valid();
+  if (slope_ok && near_cutoff > 0.0) near_pair_difference(near_now);
   for (int i = 0; i < nlocal; i++) {
-    domain->unmap(atom->x[i], atom->image[i], eval_state[i]);
-    eval_state[i][3] = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
+    double *st = eval_state[i];
+    for (int k = 0; k < 4; k++) {
+      st[EVAL_SLOPE + k] = st[EVAL_FIELD + k];    // E(t_p) + D until the new evaluation is in
+      if (slope_ok && near_cutoff > 0.0) st[EVAL_SLOPE + k] += near_now[i][k];
+    }
+    domain->unmap(atom->x[i], atom->image[i], &st[EVAL_X]);
+    st[EVAL_Q] = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
   }
   box_computed[0] = domain->boxlo[0];
   box_computed[1] = domain->boxlo[1];
   box_computed[2] = domain->xprd;
   box_computed[3] = domain->yprd;
-  evaluate_into(eval_state, 4);
-  for (int i = 0; i < nlocal; i++)
-    for (int k = 0; k < 4; k++) field[i][k] = eval_state[i][4 + k];
+  evaluate_into(eval_state, EVAL_FIELD);
+
+  const double steps_between = slope_ok ? (double) (step - last_computed) : 1.0;
+  for (int i = 0; i < nlocal; i++) {
+    double *st = eval_state[i];
+    for (int k = 0; k < 4; k++) {
+      st[EVAL_SLOPE + k] =
+          slope_ok ? (st[EVAL_FIELD + k] - st[EVAL_SLOPE + k]) / steps_between : 0.0;
+      field[i][k] = st[EVAL_FIELD + k];
+    }
+  }
 }
 
 /* ----------------------------------------------------------------------
@@ -539,16 +577,39 @@ void FixCoulFMM::evaluate_into(double **out, int col)
 }
 
 /* ----------------------------------------------------------------------
-   multiple time stepping with a near refresh: between evaluations the field of the pairs
-   closer than the near cutoff follows the atoms, the rest stays as evaluated,
-     E_i(t) = E_i(t_e) + C sum_{j: |r_ij(t)| < rc} q_j [K(r_ij(t)) - K(r_ij(t_e))],  K(r) = r / |r|^3,
-   with r_ij(t_e) = r_ij(t) - (d_i - d_j), d = displacement since the evaluation at t_e (the
-   same for every image of an atom, so periodic images need no special case)
+   multiple time stepping between evaluations (doc/theory.md, MTS): the far part is
+   extrapolated with its slope, the field of the pairs closer than the near cutoff follows the
+   atoms,
+     E_i(t) = E_i(t_e) + (t - t_e) S_i + C sum_{j: |r_ij(t)| < rc} q_j [K(r_ij(t)) - K(r_ij(t_e))]
+   K(r) = r / |r|^3, with r_ij(t_e) = r_ij(t) - (d_i - d_j), d = displacement since the
+   evaluation at t_e (the same for every image of an atom, so periodic images need no special
+   case), S_i the slope of the far part (0 with extrapolate no)
 ------------------------------------------------------------------------- */
 
-void FixCoulFMM::refresh_near_pairs()
+void FixCoulFMM::advance_field()
+{
+  const double steps = (double) (update->ntimestep - last_computed);
+  if (near_cutoff > 0.0) near_pair_difference(near_now);
+  for (int i = 0; i < atom->nlocal; i++)
+    for (int k = 0; k < 4; k++)
+      field[i][k] = eval_state[i][EVAL_FIELD + k] +
+          (extrapolate ? steps * eval_state[i][EVAL_SLOPE + k] : 0.0) +
+          (near_cutoff > 0.0 ? near_now[i][k] : 0.0);
+}
+
+/* ----------------------------------------------------------------------
+   out[i] = C sum_{j: |r_ij(t)| < rc} q_j [(K, 1/r)(r_ij(t)) - (K, 1/r)(r_ij(t_e))] for the
+   local atoms, t_e the last evaluation
+------------------------------------------------------------------------- */
+
+void FixCoulFMM::near_pair_difference(double **&out)
 {
   const int nlocal = atom->nlocal, nall = nlocal + atom->nghost;
+  if (atom->nmax > nmax_near) {
+    nmax_near = atom->nmax;
+    memory->destroy(out);
+    memory->create(out, nmax_near, 4, "coul/fmm:near_now");
+  }
   if (nall > nmax_ghost) {
     nmax_ghost = atom->nmax;
     memory->destroy(near_delta);
@@ -558,16 +619,17 @@ void FixCoulFMM::refresh_near_pairs()
   double xu[3];
   for (int i = 0; i < nlocal; i++) {
     domain->unmap(x[i], atom->image[i], xu);
-    for (int k = 0; k < 3; k++) near_delta[i][k] = xu[k] - eval_state[i][k];
+    for (int k = 0; k < 3; k++) near_delta[i][k] = xu[k] - eval_state[i][EVAL_X + k];
   }
   comm->forward_comm(this);
 
   const double c = force->qqrd2e, near_cutsq = near_cutoff * near_cutoff;
   double *q = atom->q;
   int *mask = atom->mask;
+  for (int i = 0; i < nlocal; i++)
+    for (int k = 0; k < 4; k++) out[i][k] = 0.0;
   for (int ii = 0; ii < list->inum; ii++) {
     const int i = list->ilist[ii];
-    for (int k = 0; k < 4; k++) field[i][k] = eval_state[i][4 + k];
     if (!(mask[i] & groupbit) || q[i] == 0.0) continue;
     const int *jlist = list->firstneigh[i];
     double e[4] = {0.0, 0.0, 0.0, 0.0};
@@ -590,7 +652,7 @@ void FixCoulFMM::refresh_near_pairs()
       for (int k = 0; k < 3; k++) e[k] += sn * now[k] - st * then[k];
       e[3] += q[j] / rn - q[j] / rt;
     }
-    for (int k = 0; k < 4; k++) field[i][k] += c * e[k];
+    for (int k = 0; k < 4; k++) out[i][k] = c * e[k];
   }
 }
 
@@ -706,7 +768,7 @@ double FixCoulFMM::compute_vector(int n)
 
 double FixCoulFMM::memory_usage()
 {
-  double bytes = 12.0 * atom->nmax * sizeof(double) + 3.0 * nmax_ghost * sizeof(double);
+  double bytes = (4.0 + EVAL_COLS) * atom->nmax * sizeof(double) + 3.0 * nmax_ghost * sizeof(double);
   bytes += (double) (gx.capacity() * 14) * sizeof(double);    // gathered atoms and results
   return bytes;
 }
@@ -716,35 +778,35 @@ double FixCoulFMM::memory_usage()
 void FixCoulFMM::grow_arrays(int nmax)
 {
   memory->grow(field, nmax, 4, "coul/fmm:field");
-  memory->grow(eval_state, nmax, 8, "coul/fmm:eval_state");
+  memory->grow(eval_state, nmax, EVAL_COLS, "coul/fmm:eval_state");
   array_atom = field;
 }
 
 void FixCoulFMM::copy_arrays(int i, int j, int /*delflag*/)
 {
   for (int k = 0; k < 4; k++) field[j][k] = field[i][k];
-  for (int k = 0; k < 8; k++) eval_state[j][k] = eval_state[i][k];
+  for (int k = 0; k < EVAL_COLS; k++) eval_state[j][k] = eval_state[i][k];
 }
 
 // a created atom has no stored field; its charge 0 in eval_state marks it as new
 void FixCoulFMM::set_arrays(int i)
 {
   for (int k = 0; k < 4; k++) field[i][k] = 0.0;
-  for (int k = 0; k < 8; k++) eval_state[i][k] = 0.0;
+  for (int k = 0; k < EVAL_COLS; k++) eval_state[i][k] = 0.0;
 }
 
 int FixCoulFMM::pack_exchange(int i, double *buf_out)
 {
   for (int k = 0; k < 4; k++) buf_out[k] = field[i][k];
-  for (int k = 0; k < 8; k++) buf_out[4 + k] = eval_state[i][k];
-  return 12;
+  for (int k = 0; k < EVAL_COLS; k++) buf_out[4 + k] = eval_state[i][k];
+  return 4 + EVAL_COLS;
 }
 
 int FixCoulFMM::unpack_exchange(int nlocal, double *buf_in)
 {
   for (int k = 0; k < 4; k++) field[nlocal][k] = buf_in[k];
-  for (int k = 0; k < 8; k++) eval_state[nlocal][k] = buf_in[4 + k];
-  return 12;
+  for (int k = 0; k < EVAL_COLS; k++) eval_state[nlocal][k] = buf_in[4 + k];
+  return 4 + EVAL_COLS;
 }
 
 int FixCoulFMM::pack_forward_comm(int n, int *list_send, double *buf_out, int /*pbc_flag*/,
@@ -792,10 +854,10 @@ void FixCoulFMM::restart(char *buf)
 
 int FixCoulFMM::pack_restart(int i, double *buf_out)
 {
-  buf_out[0] = 13;    // count first, as atom->extra is shared by the fixes
+  buf_out[0] = 5 + EVAL_COLS;    // count first, as atom->extra is shared by the fixes
   for (int k = 0; k < 4; k++) buf_out[1 + k] = field[i][k];
-  for (int k = 0; k < 8; k++) buf_out[5 + k] = eval_state[i][k];
-  return 13;
+  for (int k = 0; k < EVAL_COLS; k++) buf_out[5 + k] = eval_state[i][k];
+  return 5 + EVAL_COLS;
 }
 
 void FixCoulFMM::unpack_restart(int nlocal, int nth)
@@ -805,15 +867,15 @@ void FixCoulFMM::unpack_restart(int nlocal, int nth)
   for (int i = 0; i < nth; i++) m += static_cast<int>(extra[nlocal][m]);
   m++;
   for (int k = 0; k < 4; k++) field[nlocal][k] = extra[nlocal][m++];
-  for (int k = 0; k < 8; k++) eval_state[nlocal][k] = extra[nlocal][m++];
+  for (int k = 0; k < EVAL_COLS; k++) eval_state[nlocal][k] = extra[nlocal][m++];
 }
 
 int FixCoulFMM::size_restart(int /*nlocal*/)
 {
-  return 13;
+  return 5 + EVAL_COLS;
 }
 
 int FixCoulFMM::maxsize_restart()
 {
-  return 13;
+  return 5 + EVAL_COLS;
 }

@@ -65,6 +65,7 @@ class FixCoulFMM : public Fix {
   std::unique_ptr<gcfmm::Solver> solver;
   int solver_boundary;    // the gcfmm::Boundary the solver was made for
   int every;                 // full evaluation on steps that are multiples of every
+  bool extrapolate;          // between evaluations extrapolate the far part linearly
   double near_cutoff;        // pairs closer than this are refreshed every step (0: off)
   bigint last_computed;      // step of the last FMM evaluation (-1: none yet)
   bigint natoms_computed;    // atom count at that evaluation (atoms added -> recompute)
@@ -73,7 +74,8 @@ class FixCoulFMM : public Fix {
   double energy_local, energy_all;
   bool energy_summed;
   double **field;    // per atom: Ex, Ey, Ez, potential (force/charge, energy/charge)
-  double **eval_state;    // per atom at the last evaluation: unwrapped x, y, z, charge
+  double **eval_state;    // per atom at the last evaluation: position, charge, field, far part
+                          // and its slope (EVAL_* columns in the .cpp)
   double **near_delta;    // per atom incl. ghosts: displacement since the last evaluation
   int nmax_ghost;         // allocated rows of near_delta
   class NeighList *list;
@@ -82,6 +84,8 @@ class FixCoulFMM : public Fix {
   int nmax_check;
   double check_last, check_max;        // measured MTS errors
   double check_num, check_den;         // their sums of squares over all checks
+  double **near_now;                   // near-pair difference of the field (refresh)
+  int nmax_near;
   bool logged;
 
   // gathered charged atoms of the group, sorted by atom ID (identical on every rank)
@@ -97,10 +101,11 @@ class FixCoulFMM : public Fix {
 
   void check_other_coul_fmm_fixes();
   bool stored_field_valid();
-  void compute_field();
+  void compute_field(bool with_slope);
+  void near_pair_difference(double **&out);
+  void advance_field();
   void evaluate_into(double **out, int col);
   void measure_mts_error();
-  void refresh_near_pairs();
   void apply_field(int vflag);
   void gather_charges();
 };
