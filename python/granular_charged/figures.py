@@ -86,13 +86,14 @@ def _draw_spheres(ax, snap, Z, view_axis=1):
     rgb = cmap(norm(np.minimum(Z, len(paper.Z_COLORS) - 1)))[:, :3]
     shade = 0.55 + 0.45 * (1 - (depth - depth.min()) / max(np.ptp(depth), 1e-300))
     col = np.clip(rgb * shade[:, None], 0, 1)[order]
-    d = 2 * snap["radius"][order]
+    rp = float(snap["radius"].mean())
+    d = 2 * snap["radius"][order] / rp
     ec = EllipseCollection(d, d, np.zeros_like(d), units="xy", offsets=np.column_stack(
-        [snap["x"][order], snap["z"][order]]), offset_transform=ax.transData, facecolors=col,
-        edgecolors="k", linewidths=0.2)
+        [snap["x"][order] / rp, snap["z"][order] / rp]), offset_transform=ax.transData,
+        facecolors=col, edgecolors="k", linewidths=0.2)
     ax.add_collection(ec)
-    ax.set_xlim(snap.box[0])
-    ax.set_ylim(0, float((snap["z"] + snap["radius"]).max()) * 1.02)
+    ax.set_xlim(snap.box[0] / rp)
+    ax.set_ylim(0, float((snap["z"] + snap["radius"]).max()) / rp * 1.02)
     ax.set_aspect("equal")
 
 
@@ -109,18 +110,28 @@ def packing_image(result: dict, out: Path, name: str | None = None) -> Path:
     return save(fig, Path(out) / name)
 
 
+def _crop_white(img, pad=8):
+    """The rendered image without its white margins (dump image frames the whole box)."""
+    mask = img[..., :3].min(axis=-1) < 0.97
+    if not mask.any():
+        return img
+    r = np.flatnonzero(mask.any(axis=1))
+    c = np.flatnonzero(mask.any(axis=0))
+    return img[max(r[0] - pad, 0): r[-1] + pad + 1, max(c[0] - pad, 0): c[-1] + pad + 1]
+
+
 def _packing_panel(fig, ax, result):
     p = result["params"]
     img = Path(result["dir"]) / "packing.png"
     if img.exists():
-        ax.imshow(mpimg.imread(img))
+        ax.imshow(_crop_white(mpimg.imread(img)))
         ax.set_axis_off()
         how = "LAMMPS dump image"
     else:
         snap = packing.read_dump(Path(result["dir"]) / "final.dump", last_only=True)
         _draw_spheres(ax, snap, packing.coordination(snap))
-        ax.set_xlabel("x / m")
-        ax.set_ylabel("z / m")
+        ax.set_xlabel("x / r_p")
+        ax.set_ylabel("z / r_p")
         how = "side view (no dump image in the build)"
     ax.set_title(f"q = {p['q']:g} e0: phi = {result['phi']:.3f}, <Z> = {result['Z']:.2f}\n"
                  f"N = {result['natoms']}, L = {p['extra'].get('L_rp', 28)} r_p ({how})",
@@ -170,36 +181,39 @@ def read_pair_forces(final_dump: Path, forces_dump: Path):
 
 def _force_panel(ax, snap, i, j, F, FC, rp, wmax, title):
     """Lines between centres of the pairs of a slice of width 3 r_p (|y - L_y/2| <= 1.5 r_p,
-    both particles), x-z plane; red compressive, blue tensile, width proportional to |F_n|."""
+    both particles), x-z plane in units of r_p; red compressive, blue tensile, width
+    proportional to |F_n|."""
     yc = snap.box[1].mean()
     dy_i = snap["y"] - yc
     dy_i -= snap.ly * np.round(dy_i / snap.ly)
     ins = np.abs(dy_i) <= 1.5 * rp
     keep = ins[i] & ins[j]
     i, j, F = i[keep], j[keep], F[keep]
-    xi, zi = snap["x"][i], snap["z"][i]
-    dx = snap["x"][j] - xi
-    dx -= snap.lx * np.round(dx / snap.lx)          # minimum image across the periodic x
-    seg = np.stack([np.column_stack([xi, zi]), np.column_stack([xi + dx, snap["z"][j]])], axis=1)
+    x, z = snap["x"] / rp, snap["z"] / rp
+    lx = snap.lx / rp
+    dx = x[j] - x[i]
+    dx -= lx * np.round(dx / lx)          # minimum image across the periodic x
+    seg = np.stack([np.column_stack([x[i], z[i]]), np.column_stack([x[i] + dx, z[j]])], axis=1)
     # particles of the slice as faint outlines, for orientation
-    d = 2 * snap["radius"][ins]
+    d = 2 * snap["radius"][ins] / rp
     ax.add_collection(EllipseCollection(d, d, np.zeros_like(d), units="xy",
-                                        offsets=np.column_stack([snap["x"][ins], snap["z"][ins]]),
+                                        offsets=np.column_stack([x[ins], z[ins]]),
                                         offset_transform=ax.transData, facecolors="none",
                                         edgecolors="0.8", linewidths=0.3))
     col = np.where(F[:, None] > 0, [[0.85, 0.1, 0.1]], [[0.1, 0.25, 0.9]])
     lw = 0.3 + 4.0 * np.abs(F) / wmax
     ax.add_collection(LineCollection(seg, colors=col, linewidths=lw, capstyle="round"))
-    ax.set_xlim(snap.box[0])
-    ax.set_ylim(0, float((snap["z"] + snap["radius"]).max()))
+    ax.set_xlim(snap.box[0] / rp)
+    ax.set_ylim(0, float((z + snap["radius"] / rp).max()))
     ax.set_aspect("equal")
-    ax.set_xlabel("x / m")
-    ax.set_ylabel("z / m")
+    ax.set_xlabel("x / r_p")
+    ax.set_ylabel("z / r_p")
     ncomp, nten = int((F > 0).sum()), int((F < 0).sum())
     ax.set_title(f"{title}\n{ncomp} compressive, {nten} tensile contacts in the slice",
                  fontsize=8)
-    return pd.DataFrame({"id_i": snap["id"][i], "id_j": snap["id"][j], "x_i": xi, "z_i": zi,
-                         "x_j": xi + dx, "z_j": snap["z"][j], "Fn": F, "Fn_over_FC": F / FC})
+    return pd.DataFrame({"id_i": snap["id"][i], "id_j": snap["id"][j], "x_i_rp": x[i],
+                         "z_i_rp": z[i], "x_j_rp": x[i] + dx, "z_j_rp": z[j], "Fn": F,
+                         "Fn_over_FC": F / FC})
 
 
 def force_network(panels: list[tuple[str, Path, Path]], params: dict, out: Path,

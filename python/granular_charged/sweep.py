@@ -99,28 +99,53 @@ class Sweep:
         # count, so they do not make the rate (and the ETA) look faster than it is
         with logging_redirect_tqdm(), tqdm(total=n, initial=n - len(todo), unit="run",
                                            desc="sweep", disable=not self.progress or not todo,
-                                           dynamic_ncols=True) as bar, \
-                ThreadPoolExecutor(self.jobs) as ex:
-            futs = [ex.submit(one, kp) for kp in todo]
-            for f in as_completed(futs):
-                try:
-                    k, p, r = f.result()
-                except RunError as e:
-                    failed.append(str(e))
-                    new_done += 1
-                    bar.update(1)
-                    log.error("run FAILED %s: %s", eta(), e)
-                    if not self.keep_going:
-                        raise
-                    continue
-                results[k] = r
+                                           dynamic_ncols=True) as bar:
+            def finished(k, p, r, err):
+                nonlocal new_done
                 new_done += 1
                 bar.update(1)
-                log.info("%s %s  %6.1f s  phi = %.4f  <Z> = %.3f  lost %d  flying %d", eta(),
-                         p.key(), r["wall_s"], r["phi"], r["Z"], r["lost"], r["flying"])
+                if err is not None:
+                    failed.append(str(err))
+                    log.error("run FAILED %s: %s", eta(), err)
+                    if not self.keep_going:
+                        raise err
+                    return
+                results[k] = r
+                log.info("%s %s  %6.1f s  phi = %s  <Z> = %s  lost %d  flying %d", eta(),
+                         p.key(), r["wall_s"], fmt(r["phi"], ".4f"), fmt(r["Z"], ".3f"),
+                         r["lost"], r["flying"])
+
+            if self.jobs == 1:
+                # in this thread: Ctrl-C (KeyboardInterrupt) stops the running LAMMPS child
+                # (subprocess.run kills it) and leaves its folder without result.json
+                for kp in todo:
+                    try:
+                        done = one(kp)
+                    except RunError as e:
+                        finished(*kp, None, e)
+                        continue
+                    finished(*done, None)
+            else:
+                ex = ThreadPoolExecutor(self.jobs)
+                try:
+                    futs = {ex.submit(one, kp): kp for kp in todo}
+                    for f in as_completed(futs):
+                        try:
+                            done = f.result()
+                        except RunError as e:
+                            finished(*futs[f], None, e)
+                            continue
+                        finished(*done, None)
+                finally:
+                    ex.shutdown(wait=True, cancel_futures=True)
         if failed:
             log.warning("sweep: %d of %d runs failed", len(failed), n)
         return [results[k] for k in sorted(results)]
+
+
+def fmt(v, spec: str) -> str:
+    """A number for a log line; 'none' for a missing one (a bed too thin for the slab)."""
+    return "none" if v is None or v != v else format(v, spec)
 
 
 def load_results(out: Path) -> list[dict]:
