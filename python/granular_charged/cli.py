@@ -119,6 +119,8 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--jobs", type=int, default=1, help="runs at a time")
         p.add_argument("--np", type=int, default=1, help="MPI ranks per run")
         p.add_argument("--no-render", action="store_true", help="no rendered packing images")
+        p.add_argument("--tracer", type=int, default=None,
+                       help="particle id to follow in the first seed's runs (default N/2)")
     return ap
 
 
@@ -156,7 +158,7 @@ def cmd_run(a) -> int:
     state = "finished before (not run again)" if r["skipped"] else f"{r['wall_s']:.1f} s"
     log.info("%s: phi = %s, <Z> = %s, %d atoms, lost %d, flying %d (%s)", p.key(),
              fmt(r["phi"], ".4f"), fmt(r["Z"], ".3f"), r["natoms"], r["lost"], r["flying"], state)
-    print(Path(r["dir"]) / "result.json")
+    print((Path(r["dir"]) / "result.json").resolve())
     return 0
 
 
@@ -213,7 +215,8 @@ def cmd_demo(a, reproduce=False) -> int:
     extra = dict(DEMO_VARS)
     extra.update({k: v for k, v in a.var})
     study = Study(out=Path(a.out), N=a.N, qs=tuple(a.q), seeds=tuple(a.seeds),
-                  table2_qs=tuple(a.table2_q), extra=extra, jobs=a.jobs, progress=a.progress)
+                  table2_qs=tuple(a.table2_q), extra=extra, jobs=a.jobs, progress=a.progress,
+                  tracer=a.tracer)
     res = study.run(runner)
     print(report(res, study))
     if reproduce:

@@ -39,6 +39,7 @@ class Study:
     extra: dict = field(default_factory=lambda: dict(DEMO_VARS))
     jobs: int = 1
     progress: bool = True
+    tracer: int | None = None     # particle followed in the first seed's runs (None: N/2)
 
     def params(self, have_fmm: bool) -> list[DepositionParams]:
         qs = self.qs if have_fmm else [q for q in self.qs if q == 0]
@@ -55,7 +56,7 @@ class Study:
         params = self.params(have_fmm)
         first = self.seeds[0]
         results = Sweep(runner, out / "runs", jobs=self.jobs, progress=self.progress).run(
-            params, tracer=lambda p: self.N // 2 if p.seed == first else 0)
+            params, tracer=lambda p: (self.tracer or self.N // 2) if p.seed == first else 0)
         runs = tables.runs_frame(results)
         summ = tables.summary(runs)
         runs.drop(columns=["dir"]).to_csv(out / "runs.csv", index=False)

@@ -445,14 +445,17 @@ def tracer_energy(results, out: Path):
         tr = [s for s in packing.read_dump(Path(r["dir"]) / "tracer.dump") if s.n == 1]
         fin = packing.read_dump(Path(r["dir"]) / "final.dump", last_only=True)
         bed = fin["id"] < tid
-        if not tr or not bed.any():
+        if not tr:
             continue
         pos = np.array([[s["x"][0], s["y"][0], s["z"][0]] for s in tr])
         vel = np.array([[s["vx"][0], s["vy"][0], s["vz"][0]] for s in tr])
         d = pos[:, None, :] - np.column_stack([fin["x"][bed], fin["y"][bed], fin["z"][bed]])[None]
         d[..., 0] -= fin.lx * np.round(d[..., 0] / fin.lx)
         d[..., 1] -= fin.ly * np.round(d[..., 1] / fin.ly)
-        gaps = (np.sqrt((d * d).sum(-1)).min(axis=1) - 2 * p["rp"]) / p["rp"]
+        # gap to the nearest earlier particle or to the floor (z = 0), whichever is closer
+        near = (np.sqrt((d * d).sum(-1)).min(axis=1) if bed.any()
+                else np.full(len(pos), np.inf))
+        gaps = np.minimum(near - 2 * p["rp"], pos[:, 2] - p["rp"]) / p["rp"]
         m = 4.0 / 3.0 * math.pi * p["rp"] ** 3 * p["rho"]
         eks = 0.5 * m * (vel * vel).sum(1) / (0.5 * m * p["U0"] ** 2)
         k = int(np.argmax(gaps <= 0)) if (gaps <= 0).any() else len(gaps) - 1
@@ -460,7 +463,7 @@ def tracer_energy(results, out: Path):
         frames.append(pd.DataFrame({"q": p["q"], "gap_over_rp": gaps, "Ek_over_Ek0": eks}))
     ax.axvline(0, color="grey", ls="--", lw=0.8)
     ax.set_xscale("symlog", linthresh=0.1)
-    ax.set_xlabel("gap to nearest deposited particle / r_p")
+    ax.set_xlabel("gap to the nearest deposited particle or the floor / r_p")
     ax.set_ylabel("E_k / E_k0")
     ax.legend(fontsize=7)
     return save(fig, Path(out) / "tracer_energy.png", pd.concat(frames) if frames else None)

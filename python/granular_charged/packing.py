@@ -241,7 +241,7 @@ def analyse(snap: Snapshot, rp: float, zlo_rp=4.0, top_rp=6.0, tol=0.0) -> dict:
     """phi, <Z>, f(Z) of the analysis slab of a final snapshot (the decks' rule)."""
     zlo, zhi = analysis_slab(snap, rp, zlo_rp, top_rp)
     out = {"zlo": zlo, "zhi": zhi, "slab_thickness_rp": (zhi - zlo) / rp}
-    if zhi - zlo < 2.0 * rp:
+    if zhi <= zlo:      # in.deposition's rule (slab_ok): a slab exists when zhi > zlo
         out.update({"phi": float("nan"), "Z": float("nan"), "fZ": [], "n_slab": 0,
                     "warning": "bed too thin for the analysis slab"})
         return out
