@@ -60,3 +60,29 @@ def run_table2(runner: Runner, formed: Path, qs, out: Path, extra: dict | None =
                  r["phi_before"], r["phi_after"], r["Z_before"], r["Z_after"], r["wall_s"])
     tables.table2_frame(rows).to_csv(out / "table2.csv", index=False)
     return rows
+
+
+def main(argv=None) -> int:
+    """python3 -m granular_charged.after_formation --formed RUN_DIR --q ... --out DIR"""
+    import argparse
+
+    from .cli import setup_logging
+    from .lammps_build import LammpsBuild
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--formed", required=True, help="run folder of a neutral deposition")
+    ap.add_argument("--q", type=float, nargs="+", default=[0.0, 260.0, 400.0])
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--build-dir", default=None)
+    ap.add_argument("--np", type=int, default=1)
+    ap.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"))
+    a = ap.parse_args(argv)
+    setup_logging(0, 0)
+    runner = Runner(LammpsBuild.find(a.build_dir), np_ranks=a.np)
+    rows = run_table2(runner, Path(a.formed), a.q, Path(a.out), dict(a.var))
+    print(tables.format_table(tables.table2_frame(rows), "{:.5g}"))
+    return 0
+
+
+if __name__ == "__main__":
+    import sys
+    sys.exit(main())

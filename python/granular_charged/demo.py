@@ -137,3 +137,10 @@ def claims_report(res: dict) -> str:
             f"q = {q:g}: {p:.4f} (phi_0/phi - 1 = {e:+.3f})"
             for q, p, e in zip(ch["q"], ch["phi"], ch["expansion"])))
     return "\n".join(lines)
+
+
+if __name__ == "__main__":      # the older spelling, python3 -m granular_charged.demo ...
+    import sys
+
+    from .cli import main
+    sys.exit(main(["demo", *sys.argv[1:]]))

@@ -161,3 +161,10 @@ def load_results(out: Path) -> list[dict]:
             r["dir"] = str(f.parent)
             res.append(r)
     return res
+
+
+if __name__ == "__main__":      # the older spelling, python3 -m granular_charged.sweep ...
+    import sys
+
+    from .cli import main
+    sys.exit(main(["sweep", *sys.argv[1:]]))

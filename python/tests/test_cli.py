@@ -2,6 +2,7 @@
 package installed with pip into a fresh virtual environment (offline) running outside the
 checkout."""
 import os
+import shutil
 import subprocess
 import sys
 from importlib import resources
@@ -57,13 +58,17 @@ def test_pip_install_offline_into_fresh_venv_and_run_outside_checkout(build_dir,
     exists here): the in-tree backend takes setuptools and wheel from the system. Then the
     console script runs a tiny deposition from a folder outside the checkout, with the decks
     from the installed package."""
+    # a copy of python/, so that the build (build/, *.egg-info) does not write into the checkout
+    src = tmp_path / "src"
+    shutil.copytree(SRC / "python", src, ignore=shutil.ignore_patterns(
+        "build", "*.egg-info", "__pycache__", "tests"))
     venv = tmp_path / "venv"
     subprocess.run(["/usr/bin/python3", "-m", "venv", "--system-site-packages", str(venv)],
                    check=True)
     env = {k: v for k, v in os.environ.items()
            if k not in ("PYTHONPATH", "GC_BUILD_DIR", "GC_SOURCE_DIR")}
     env["PIP_NO_INDEX"] = "1"                 # no index, as on the CI machine
-    r = subprocess.run([str(venv / "bin" / "pip"), "install", str(SRC / "python")], env=env,
+    r = subprocess.run([str(venv / "bin" / "pip"), "install", str(src)], env=env,
                        capture_output=True, text=True)
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
     exe = venv / "bin" / "granular-charged"
