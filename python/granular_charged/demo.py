@@ -14,6 +14,7 @@ import logging
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import MappingProxyType
 
 from . import figures, paper, tables
 from .after_formation import run_table2
@@ -23,7 +24,7 @@ from .sweep import Sweep
 
 log = logging.getLogger(__name__)
 
-DEMO_VARS = {"L_rp": 14, "gap_rp": 1, "coul_every": 10}
+DEMO_VARS = MappingProxyType({"L_rp": 14, "gap_rp": 1, "coul_every": 10})   # read-only
 FULL_COMMAND = ("granular-charged sweep --preset paper --N 2000 --seeds 1 2 3 "
                 "--out paper-results --figures paper-figures")
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import logging
 import math
 from pathlib import Path
+from types import MappingProxyType
 
 import matplotlib.image as mpimg
 import numpy as np
@@ -30,7 +31,7 @@ log = logging.getLogger(__name__)
 G2_NOTE = ("Eqs. 9-10 of the paper (Edwards volume-function equation of state) are not drawn: "
            "they need the g_2(r, Z) model of Liu et al., Soft Matter 11 (2015) 6492, which is "
            "not implemented here.")
-PAPER_STYLE = dict(color="k", ls=":", lw=1.0)
+PAPER_STYLE = MappingProxyType(dict(color="k", ls=":", lw=1.0))   # read-only
 
 
 def new_figure(w: float, h: float) -> Figure:

@@ -13,6 +13,7 @@ import logging
 import time
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from pathlib import Path
+from types import MappingProxyType
 
 from tqdm import tqdm
 from tqdm.contrib.logging import logging_redirect_tqdm
@@ -24,14 +25,14 @@ log = logging.getLogger(__name__)
 
 # The paper's cases (its Figs. 2, 3a-c, 5a-c, 9, 10), N = 2000, L = 28 r_p, H = 160 r_p.
 # Charges stay below E* = 1 (physics.md sec. 2) for each (r_p, U_0).
-PAPER_SETS = (
+PAPER_SETS = tuple(MappingProxyType(s) for s in (
     dict(rp=2e-6, U0=1.0, gamma=0.010, q=[0, 100, 200, 260, 330, 400]),   # Figs. 2, 3c, 4, 5a, 7
     dict(rp=1e-6, U0=1.0, gamma=0.010, q=[0, 30, 60, 90, 120]),           # Figs. 3a, 5c
     dict(rp=1e-6, U0=2.0, gamma=0.010, q=[0, 60, 120, 180, 240]),         # Fig. 3b
     dict(rp=2e-6, U0=0.5, gamma=0.010, q=[0, 100, 200]),                  # Fig. 5b
     dict(rp=2e-6, U0=1.0, gamma=0.015, q=[0, 260, 400]),                  # Ad* spread (Fig. 9)
     dict(rp=5e-6, U0=1.0, gamma=0.010, q=[0, 1000, 2000]),                # r_p = 5 um (Table 1)
-)
+))
 
 
 def expand(sets, N, seeds, extra) -> list[DepositionParams]:

@@ -6,7 +6,7 @@ import pandas as pd
 
 from . import paper
 
-CASE = ["rp_um", "U0", "gamma_mJ", "q"]    # a case: everything but the seed
+CASE = ("rp_um", "U0", "gamma_mJ", "q")    # a case: everything but the seed
 
 
 def runs_frame(results: list[dict]) -> pd.DataFrame:
@@ -23,7 +23,7 @@ def runs_frame(results: list[dict]) -> pd.DataFrame:
             "natoms": r["natoms"], "lost": r["lost"], "flying": r["flying"],
             "wall_s": r.get("wall_s"), "key": r["key"], "dir": r.get("dir"),
         })
-    cols = CASE + ["seed", "N", "Ad", "Estar", "Adstar", "phi", "Z", "phi_python", "Z_python",
+    cols = list(CASE) + ["seed", "N", "Ad", "Estar", "Adstar", "phi", "Z", "phi_python", "Z_python",
                    "natoms", "lost", "flying", "wall_s", "key", "dir"]
     return pd.DataFrame(rows, columns=cols)
 
@@ -32,7 +32,7 @@ def summary(runs: pd.DataFrame) -> pd.DataFrame:
     """Per case (r_p, U_0, gamma, q): runs, mean and standard deviation of phi and <Z> over the
     seeds, the groups, atoms, particles lost, mean wall time; and phi_0/phi - 1 against the
     neutral case of the same (r_p, U_0, gamma) (NaN without one)."""
-    s = (runs.groupby(CASE, as_index=False)
+    s = (runs.groupby(list(CASE), as_index=False)
          .agg(runs=("phi", "size"), phi=("phi", "mean"), phi_sd=("phi", "std"),
               Z=("Z", "mean"), Z_sd=("Z", "std"), Ad=("Ad", "first"), Estar=("Estar", "first"),
               Adstar=("Adstar", "first"), N=("natoms", "mean"), lost=("lost", "sum"),
