@@ -459,8 +459,14 @@ def tracer_energy(results, out: Path):
         gaps = np.minimum(near - 2 * p["rp"], pos[:, 2] - p["rp"]) / p["rp"]
         m = 4.0 / 3.0 * math.pi * p["rp"] ** 3 * p["rho"]
         eks = 0.5 * m * (vel * vel).sum(1) / (0.5 * m * p["U0"] ** 2)
-        k = int(np.argmax(gaps <= 0)) if (gaps <= 0).any() else len(gaps) - 1
-        ax.plot(gaps[: k + 1], eks[: k + 1], label=f"q = {p['q']:g} e0 (particle {tid})")
+        # first contact: the first jump of E_k between samples (> 1 % of E_k0; in free flight,
+        # gravity and the Coulomb field change it by ~1e-4 per sample). The gap is measured to
+        # the final positions of the earlier particles, which may have moved since
+        jumps = np.flatnonzero(np.abs(np.diff(eks)) > 0.01)
+        k = int(jumps[0]) + 1 if len(jumps) else len(eks) - 1
+        line, = ax.plot(gaps[: k + 1], eks[: k + 1], label=f"q = {p['q']:g} e0 (particle {tid}): "
+                        f"E_k/E_k0 = {eks[k - 1]:.3f} before the first contact")
+        ax.plot(gaps[k - 1], eks[k - 1], "o", color=line.get_color())
         frames.append(pd.DataFrame({"q": p["q"], "gap_over_rp": gaps, "Ek_over_Ek0": eks}))
     ax.axvline(0, color="grey", ls="--", lw=0.8)
     ax.set_xscale("symlog", linthresh=0.1)

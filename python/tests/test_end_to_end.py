@@ -130,20 +130,19 @@ def test_python_analysis_matches_computes(study):
         np.testing.assert_allclose(r["python"]["fZ"], r["fZ"], rtol=0, atol=1e-12)
 
 
-def _impact_energy(run_dir, rp, U0, rho, tracer):
-    """E_k / E_k0 of the followed particle at its last sample before its first contact (with an
-    earlier particle or the floor)."""
+def _energy_before_first_contact(run_dir, U0):
+    """E_k / E_k0 of the followed particle at its last sample before its first contact, and the
+    number of samples before it. A contact shows as a jump of E_k between samples (> 1 % of
+    E_k0): in free flight gravity and the Coulomb field change it by ~1e-4 per sample."""
     tr = [s for s in packing.read_dump(run_dir / "tracer.dump") if s.n == 1]
-    fin = packing.read_dump(run_dir / "final.dump", last_only=True)
-    bed = fin["id"] < tracer
-    pos = np.array([[s["x"][0], s["y"][0], s["z"][0]] for s in tr])
     vel = np.array([[s["vx"][0], s["vy"][0], s["vz"][0]] for s in tr])
-    d = pos[:, None, :] - np.column_stack([fin["x"][bed], fin["y"][bed], fin["z"][bed]])[None]
-    d[..., :2] -= fin.lx * np.round(d[..., :2] / fin.lx)
-    gap = np.minimum(np.sqrt((d * d).sum(-1)).min(axis=1) - 2 * rp, pos[:, 2] - rp)
-    k = int(np.argmax(gap <= 0))
-    assert k > 0 and gap[0] > 40 * rp            # sampled from the injection to the contact
-    return (vel[k - 1] ** 2).sum() / U0 ** 2
+    z = np.array([s["z"][0] for s in tr])
+    ek = (vel * vel).sum(axis=1) / U0 ** 2
+    jumps = np.flatnonzero(np.abs(np.diff(ek)) > 0.01)
+    assert len(jumps), "no contact in the tracer's record"
+    k = int(jumps[0])
+    smooth = np.abs(np.diff(ek[: k + 1])).max()
+    return ek[k], k, z[0] - z[k], smooth
 
 
 def test_incident_particle_decelerated_by_charge(study):
@@ -152,23 +151,23 @@ def test_incident_particle_decelerated_by_charge(study):
     1 + 2 g dz / U0^2 in [1, 1 + 2 * 9.81 * 60 * 2e-6 = 1.0024] exactly. Charged (q = 480 e0):
     the 29 earlier particles are below it and the 10 later ones above; as uniform sheets of
     charge n q / L^2 (field n q / (2 eps0 L^2) on either side, independent of distance) their
-    net 19 q charge does the work 19 q^2 dz / (2 eps0 L^2) = 0.11 E_k0 against it over its
-    dz = 52 r_p of fall (E_k0 = m U0^2 / 2, m = 8.4e-14 kg, L = 12 um); the paper's own estimate,
-    U_eff^2 = U0^2 (1 - E*) with E* = K_eff q^2 / (eps0 U0^2 r_p^4 rho) = 0.37 for this N and
-    L, gives 0.37. Asserted: E_k/E_k0 < 0.9 at contact, i.e. at least the sheet estimate of
-    the deceleration with its margin (measured: 0.26, a 74 % loss; the near field of the
-    particles in flight around it adds to the sheets'). Not a statistical statement: every
-    realisation has these charges below and above the particle."""
+    net 19 q charge does the work 19 q^2 dz / (2 eps0 L^2) = 0.11 E_k0 against it over a fall of
+    dz = 52 r_p (E_k0 = m U0^2 / 2, m = 8.4e-14 kg, L = 12 um). Asserted: a loss of more than
+    5 % of E_k0 (half the sheet estimate) before the first contact, with a free flight that is
+    smooth (no contact hidden in it). Measured: 0.889 after 51 r_p of fall, i.e. the sheet
+    estimate. Not statistical: every realisation has these charges below and above it."""
     by_q = {r["params"]["q"]: r for r in results(study)}
     assert by_q[0.0]["tracer"] == TRACER and by_q[Q]["tracer"] == TRACER
-    e = {q: _impact_energy(r["dir"], r["params"]["rp"], r["params"]["U0"], r["params"]["rho"],
-                           TRACER) for q, r in by_q.items()}
     m = 4 / 3 * math.pi * (2e-6) ** 3 * 2500
     sheet = 19 * (Q * 1.602176634e-19) ** 2 * 52 * 2e-6 / (2 * 8.8541878128e-12 * (12e-6) ** 2)
     assert sheet / (0.5 * m) == pytest.approx(0.11, abs=0.01)
-    assert by_q[Q]["groups"]["Estar"] == pytest.approx(0.37, abs=0.01)
-    assert 1.0 <= e[0.0] <= 1.0025
-    assert e[Q] < 0.9
+    e0, k0, fall0, smooth0 = _energy_before_first_contact(by_q[0.0]["dir"], 1.0)
+    eq, kq, fallq, smoothq = _energy_before_first_contact(by_q[Q]["dir"], 1.0)
+    rp = 2e-6
+    assert fall0 > 40 * rp and fallq > 40 * rp           # a real free flight was recorded
+    assert smooth0 < 1e-3 and smoothq < 1e-3
+    assert 1.0 <= e0 <= 1.0025
+    assert eq < 1.0 - 0.05
 
 
 def test_table2_charging_after_formation_changes_nothing(study):
