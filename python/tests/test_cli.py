@@ -4,7 +4,6 @@ checkout."""
 import os
 import shutil
 import subprocess
-import sys
 from importlib import resources
 from pathlib import Path
 
