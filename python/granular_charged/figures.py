@@ -180,7 +180,7 @@ def read_pair_forces(final_dump: Path, forces_dump: Path):
     return snap, i, j, F[nz]
 
 
-def _force_panel(ax, snap, i, j, F, FC, rp, wmax, title):
+def _force_panel(ax, snap, i, j, F, FC, rp, wmax, title, ztop):
     """Lines between centres of the pairs of a slice of width 3 r_p (|y - L_y/2| <= 1.5 r_p,
     both particles), x-z plane in units of r_p; red compressive, blue tensile, width
     proportional to |F_n|."""
@@ -205,13 +205,13 @@ def _force_panel(ax, snap, i, j, F, FC, rp, wmax, title):
     lw = 0.3 + 4.0 * np.abs(F) / wmax
     ax.add_collection(LineCollection(seg, colors=col, linewidths=lw, capstyle="round"))
     ax.set_xlim(snap.box[0] / rp)
-    ax.set_ylim(0, float((z + snap["radius"] / rp).max()))
+    ax.set_ylim(0, ztop / rp)
     ax.set_aspect("equal")
     ax.set_xlabel("x / r_p")
     ax.set_ylabel("z / r_p")
     ncomp, nten = int((F > 0).sum()), int((F < 0).sum())
-    ax.set_title(f"{title}\n{ncomp} compressive, {nten} tensile contacts in the slice",
-                 fontsize=8)
+    ax.set_title(f"{title}\n{ncomp} compressive, {nten} tensile\ncontacts in the slice",
+                 fontsize=7)
     return pd.DataFrame({"id_i": snap["id"][i], "id_j": snap["id"][j], "x_i_rp": x[i],
                          "z_i_rp": z[i], "x_j_rp": x[i] + dx, "z_j_rp": z[j], "Fn": F,
                          "Fn_over_FC": F / FC})
@@ -232,13 +232,15 @@ def force_network(panels: list[tuple[str, Path, Path]], params: dict, out: Path,
     FC = jkr_scales(rp / 2, pair_modulus(params["E"], params["nu"]), params["gamma"])["FC"]
     wmax = max(float(np.abs(F).max()) if len(F) else 0.0 for *_, F in loaded) or 1.0
     snap0 = loaded[0][1]
-    ztop = max(float((s["z"] + s["radius"]).max()) for _, s, *_ in loaded)
-    w = 2.0 + 0.9 * len(loaded) * 6.0 * snap0.lx / ztop
-    fig = new_figure(min(max(w, 6.0), 14.0), 6.0)
+    # top of the bed: the highest particle in a contact (one still bouncing above is left out)
+    ztop = max(float(s["z"][np.concatenate([i, j])].max() + 1.5 * rp) for _, s, i, j, _ in loaded
+               if len(i))
+    panel_w = 5.0 * snap0.lx / ztop           # panels 5 inches high, true aspect
+    fig = new_figure(min(max(len(loaded) * (panel_w + 1.2), 7.0), 16.0), 6.2)
     frames = []
     for k, (title, snap, i, j, F) in enumerate(loaded):
         ax = fig.add_subplot(1, len(loaded), k + 1)
-        df = _force_panel(ax, snap, i, j, F, FC, rp, wmax, f"({'abcd'[k]}) {title}")
+        df = _force_panel(ax, snap, i, j, F, FC, rp, wmax, f"({'abcd'[k]}) {title}", ztop)
         df.insert(0, "panel", title)
         frames.append(df)
     handles = [Line2D([], [], color=(0.85, 0.1, 0.1), lw=2, label="compressive (F_n > 0)"),
