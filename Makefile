@@ -33,7 +33,7 @@ test: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) --timeout 1500
 
 demo: build
-	. $(BUILD_DIR)/env.sh && /usr/bin/python3 -m granular_charged.demo --build-dir $(BUILD_DIR)
+	. $(BUILD_DIR)/env.sh && /usr/bin/python3 -m granular_charged demo --build-dir $(BUILD_DIR) --jobs 2
 
 clean:
 	rm -rf $(BUILD_DIR)

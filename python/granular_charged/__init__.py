@@ -1,5 +1,11 @@
 """GRANULAR-CHARGED Python package: run the deposition decks through LAMMPS's Python module,
 sweep parameters, analyse packings and draw the figures of Chen, Li, Liu & Makse (Soft Matter
-2016). Modules: params (Ad, E*, Ad*, JKR scales, time step), packing (phi, Z, f(Z), g(r) from
-dumps), runner (one run), sweep (many runs, resumable), figures, demo, after_formation."""
-__all__ = ["params", "packing", "runner", "sweep", "figures", "demo", "after_formation"]
+2016).
+
+Command line: ``granular-charged`` (or ``python3 -m granular_charged``), see doc/python.md.
+Modules: params (Ad, E*, Ad*, JKR scales, time step), packing (phi, Z, f(Z), g(r) from dumps),
+lammps_build (finding the LAMMPS build), runner (one run; child: the LAMMPS side), sweep (many
+runs, resumable), tables (pandas), figures, after_formation (Table 2), demo, paper (the paper's
+numbers), cli. The input decks are package data (granular_charged/decks).
+"""
+__version__ = "0.2.0"

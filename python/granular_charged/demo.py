@@ -1,118 +1,147 @@
-"""The README's demo: a REDUCED version of the paper's Fig. 2 study.
-
-  . build/env.sh && /usr/bin/python3 -m granular_charged.demo --build-dir build
+"""The README's demo: a REDUCED version of the paper's Fig. 2 study, and the checks of
+``granular-charged reproduce``.
 
 Cases: r_p = 2 um, U_0 = 1 m/s, gamma = 10 mJ/m^2, q = 0, 260, 400 e_0 (the paper's Fig. 2),
 with the paper's H = 160 r_p and material (Table 1), but a box of L = 14 r_p and N = 500
 particles instead of L = 28 r_p and N = 2000: the same number of particles per unit floor area
 (so the same bed height and the same K_eff = 20 N (L/r_p)^-2 = 51 of the paper's E*), a
-quarter of the particles. Prints a table and writes the figures into one folder.
+quarter of the particles. Then the Table 2 check on the first neutral packing, the tables and
+the figures, all in one folder.
 """
 from __future__ import annotations
 
-import argparse
-import statistics
-import sys
+import logging
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
+from types import MappingProxyType
 
-from . import figures
+from . import figures, paper, tables
+from .after_formation import run_table2
 from .params import DepositionParams
-from .runner import SOURCE_DIR, RunError, find_build, lammps_has
-from .sweep import load_results, run_sweep
+from .runner import RunError, Runner
+from .sweep import Sweep
 
-DEMO_VARS = {"L_rp": 14, "gap_rp": 1, "coul_every": 10}
-FULL_COMMAND = ("/usr/bin/python3 -m granular_charged.sweep --preset paper --N 2000 "
-                "--seeds 1 2 3 --out paper-results --figures paper-figures")
+log = logging.getLogger(__name__)
 
-
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
-    ap.add_argument("--build-dir", default=None)
-    ap.add_argument("--out", default=str(SOURCE_DIR / "demo-output"))
-    ap.add_argument("--N", type=int, default=500)
-    ap.add_argument("--q", type=float, nargs="+", default=[0.0, 260.0, 400.0])
-    ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
-    ap.add_argument("--jobs", type=int, default=2, help="runs at a time (default 2: both cores)")
-    ap.add_argument("--np", type=int, default=1)
-    a = ap.parse_args(argv)
-    t0 = time.monotonic()
-    try:
-        build = find_build(a.build_dir)
-    except RunError as e:
-        print(f"demo: {e}", file=sys.stderr)
-        return 2
-    out = Path(a.out).resolve()
-    runs = out / "runs"
-    runs.mkdir(parents=True, exist_ok=True)
-    have_fmm = lammps_has(build, "fix", "coul/fmm")
-    print("GRANULAR-CHARGED demo: a REDUCED version of the paper's Fig. 2 study")
-    print(f"  r_p = 2 um, U0 = 1 m/s, gamma = 10 mJ/m^2, q = {', '.join(f'{q:g}' for q in a.q)} e0;"
-          f" N = {a.N} in L = {DEMO_VARS['L_rp']} r_p (paper: N = 2000 in L = 28 r_p, same"
-          " particles per floor area), H = 160 r_p,"
-          f" seeds {', '.join(map(str, a.seeds))}, {a.jobs} runs at a time")
-    if not have_fmm:
-        print("  fix coul/fmm is NOT in this build: only the neutral case runs; the charged cases"
-              " need fix coul/fmm (they are not faked)")
-    qs = a.q if have_fmm else [q for q in a.q if q == 0]
-    extra = dict(DEMO_VARS)
-    params = [DepositionParams(q=q, N=a.N, seed=s, extra=dict(extra)) for q in qs for s in a.seeds]
-    first = a.seeds[0]
-    res = run_sweep(params, runs, build, a.np, jobs=a.jobs,
-                    tracer=lambda p: a.N // 2 if p.seed == first else 0)
-    # figures from these runs only
-    keys = {p.key() for p in params}
-    results = [r for r in load_results(runs) if r["key"] in keys]
-    figdir = out
-    paths = figures.all_figures(results, figdir)
-    print()
-    print(f"{'q/e0':>6} {'runs':>4} {'phi':>7} {'+-sd':>6} {'<Z>':>6} {'+-sd':>6} {'Ad':>6} {'E*':>6} "
-          f"{'Ad*':>7} {'N':>5} {'lost':>4} {'wall/s':>7}")
-    for q in sorted({r["params"]["q"] for r in results}):
-        rs = [r for r in results if r["params"]["q"] == q]
-        g = rs[0]["groups"]
-        phi = [r["phi"] for r in rs]
-        Z = [r["Z"] for r in rs]
-        sd = lambda v: statistics.stdev(v) if len(v) > 1 else float("nan")
-        print(f"{q:6g} {len(rs):4d} {statistics.fmean(phi):7.4f} {sd(phi):6.4f} "
-              f"{statistics.fmean(Z):6.3f} {sd(Z):6.3f} {g['Ad']:6.2f} {g['Estar']:6.3f} "
-              f"{g['Adstar']:7.3f} {rs[0]['natoms']:5d} {sum(r['lost'] for r in rs):4d} "
-              f"{statistics.fmean(r.get('wall_s') or 0 for r in rs):7.1f}")
-    q0 = [r["phi"] for r in results if r["params"]["q"] == 0]
-    if q0:
-        for q in sorted({r["params"]["q"] for r in results if r["params"]["q"] > 0}):
-            phiq = statistics.fmean(r["phi"] for r in results if r["params"]["q"] == q)
-            print(f"  q = {q:g} e0: phi_0/phi - 1 = {statistics.fmean(q0) / phiq - 1:+.3f}")
-    print()
-    print("paper (physics.md sec. 3): neutral phi_0 = 0.270-0.363; charge lowers phi and <Z>;"
-          " phi_0/phi - 1 ~ q^2, up to 40 %")
-    # the paper's Table 2: charge the formed neutral packing, relax, compare
-    neutral = sorted([r for r in results if r["params"]["q"] == 0], key=lambda r: r["params"]["seed"])
-    if neutral and have_fmm:
-        from .after_formation import run_table2
-        print("charged after formation (the paper's Table 2; relaxation 100 r_p/U0 per charge):")
-        try:
-            rows = run_table2(Path(neutral[0]["dir"]), a.q, out / "table2", build, a.np,
-                              {"coul_every": DEMO_VARS["coul_every"]})
-            print(f"{'q/e0':>6} {'phi before':>11} {'phi after':>10} {'<Z> before':>11} "
-                  f"{'<Z> after':>10} {'F_C/F_E':>9}")
-            for r in rows:
-                print(f"{r['q']:6g} {r['phi_before']:11.5f} {r['phi_after']:10.5f} "
-                      f"{r['Z_before']:11.4f} {r['Z_after']:10.4f} {r['FC_over_FE']:9.3g}")
-        except RunError as e:
-            print(f"  Table 2 check FAILED: {e}")
-        print("paper's Table 2: phi 0.3249 -> 0.3247, <Z> 3.2056 unchanged for q = 0 -> 400 e0")
-        print()
-    print(f"figures ({len(paths)} PNG + CSV) and tables: {figdir}")
-    print(f"this was REDUCED (N = {a.N}, L = {DEMO_VARS['L_rp']} r_p, {len(a.seeds)} seeds, Coulomb force "
-          f"recomputed every {DEMO_VARS['coul_every']} steps); the full paper set (N = 2000, "
-          "L = 28 r_p, all its cases, 3 seeds; hours) is:")
-    print(f"  . build/env.sh && {FULL_COMMAND}")
-    if not have_fmm:
-        print("NOTE: the charged cases (q != 0) were NOT run: they need fix coul/fmm in the build")
-    print(f"demo wall time: {time.monotonic() - t0:.0f} s")
-    return 0 if len(results) == len(params) else 1
+DEMO_VARS = MappingProxyType({"L_rp": 14, "gap_rp": 1, "coul_every": 10})   # read-only
+FULL_COMMAND = ("granular-charged sweep --preset paper --N 2000 --seeds 1 2 3 "
+                "--out paper-results --figures paper-figures")
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+@dataclass
+class Study:
+    """A reduced study: depositions for each q and seed, the Table 2 check, tables, figures."""
+    out: Path
+    N: int = 500
+    qs: tuple = (0.0, 260.0, 400.0)
+    seeds: tuple = (1, 2, 3)
+    table2_qs: tuple = (0.0, 260.0, 400.0)
+    extra: dict = field(default_factory=lambda: dict(DEMO_VARS))
+    jobs: int = 1
+    progress: bool = True
+    tracer: int | None = None     # particle followed in the first seed's runs (None: N/2)
+
+    def params(self, have_fmm: bool) -> list[DepositionParams]:
+        qs = self.qs if have_fmm else [q for q in self.qs if q == 0]
+        return [DepositionParams(q=q, N=self.N, seed=s, extra=dict(self.extra))
+                for q in qs for s in self.seeds]
+
+    def run(self, runner: Runner) -> dict:
+        t0 = time.monotonic()
+        out = Path(self.out).resolve()
+        have_fmm = runner.build.capabilities["coul/fmm"]
+        if not have_fmm:
+            log.warning("fix coul/fmm is NOT in this build: only the neutral case runs; the "
+                        "charged cases need fix coul/fmm (they are not faked)")
+        params = self.params(have_fmm)
+        first = self.seeds[0]
+        results = Sweep(runner, out / "runs", jobs=self.jobs, progress=self.progress).run(
+            params, tracer=lambda p: (self.tracer or self.N // 2) if p.seed == first else 0)
+        runs = tables.runs_frame(results)
+        summ = tables.summary(runs)
+        runs.drop(columns=["dir"]).to_csv(out / "runs.csv", index=False)
+        summ.to_csv(out / "summary.csv", index=False)
+        slopes = tables.expansion_slope(summ)
+        t2 = []
+        neutral = sorted((r for r in results if r["params"]["q"] == 0),
+                         key=lambda r: r["params"]["seed"])
+        if neutral and have_fmm and self.table2_qs:
+            try:
+                t2 = run_table2(runner, Path(neutral[0]["dir"]), self.table2_qs, out / "table2",
+                                {"coul_every": self.extra.get("coul_every", 1)})
+            except RunError as e:
+                log.error("Table 2 check FAILED: %s", e)
+        figs = figures.all_figures(results, out / "figures", t2)
+        return {"out": out, "results": results, "runs": runs, "summary": summ,
+                "slopes": slopes, "table2": tables.table2_frame(t2) if t2 else None,
+                "figures": figs, "wall_s": time.monotonic() - t0, "complete":
+                len(results) == len(params), "have_fmm": have_fmm}
+
+
+def report(res: dict, study: Study) -> str:
+    """The demo's printed summary."""
+    s = res["summary"]
+    lines = [
+        "GRANULAR-CHARGED demo: a REDUCED version of the paper's Fig. 2 study",
+        f"  r_p = 2 um, U0 = 1 m/s, gamma = 10 mJ/m^2, N = {study.N} in L = "
+        f"{study.extra.get('L_rp')} r_p (paper: N = 2000 in L = 28 r_p, the same particles per "
+        f"floor area), H = {study.extra.get('H_rp', 160)} r_p, seeds "
+        f"{', '.join(map(str, study.seeds))}",
+        "",
+        tables.format_table(s[["q", "runs", "phi", "phi_sd", "Z", "Z_sd", "Ad", "Estar", "Adstar",
+                               "expansion", "N", "lost", "wall_s"]]),
+        "",
+        f"paper: neutral phi_0 = {paper.PHI0_RANGE[0]}-{paper.PHI0_RANGE[1]}; charge lowers phi "
+        f"and <Z>; phi_0/phi - 1 ~ q^{paper.EXPANSION_SLOPE:g}, up to {paper.MAX_RELATIVE_DECREASE:g}",
+    ]
+    if not res["slopes"].empty:
+        lines.append("log-log slope of phi_0/phi - 1 vs q (paper 2): " + ", ".join(
+            f"{v:.2f} ({n} points)" for v, n in zip(res["slopes"]["slope"], res["slopes"]["points"])))
+    if res["table2"] is not None:
+        lines += ["", "charged after formation (the paper's Table 2; relaxation 100 r_p/U0):",
+                  tables.format_table(res["table2"][["q", "phi_before", "phi_after", "Z_before",
+                                                     "Z_after", "FC_over_FE", "paper_phi",
+                                                     "paper_Z"]], "{:.5g}")]
+    lines += ["", f"tables: {res['out']}/summary.csv, runs.csv"
+              + (", table2/table2.csv" if res["table2"] is not None else ""),
+              f"figures ({len(res['figures'])} PNG, each with its CSV): {res['out']}/figures",
+              f"this was REDUCED (N = {study.N}, L = {study.extra.get('L_rp')} r_p, "
+              f"{len(study.seeds)} seeds, Coulomb force recomputed every "
+              f"{study.extra.get('coul_every', 1)} steps); the full paper set (hours) is:",
+              f"  {FULL_COMMAND}"]
+    if not res["have_fmm"]:
+        lines.append("NOTE: the charged cases (q != 0) were NOT run: they need fix coul/fmm")
+    lines.append(f"wall time: {res['wall_s']:.0f} s")
+    return "\n".join(lines)
+
+
+def claims_report(res: dict) -> str:
+    """`reproduce`: the paper's claims, what this package checks of each, and our numbers."""
+    s = res["summary"]
+    lines = ["The paper's claims and this package's checks:"]
+    for claim, status in paper.CLAIMS:
+        lines.append(f"  - {claim}\n      {status}")
+    lines.append("")
+    if res["table2"] is not None:
+        t = res["table2"]
+        lines.append(f"Table 2 (ours, N = {int(s['N'].max())}): max |phi_after - phi_before| = "
+                     f"{t['dphi'].abs().max():.2g}, max |<Z>_after - <Z>_before| = "
+                     f"{t['dZ'].abs().max():.2g} (paper: 2e-4 and 0)")
+    neutral = s[s["q"] == 0]
+    if not neutral.empty:
+        lines.append(f"neutral phi_0 (ours): {', '.join(f'{v:.4f}' for v in neutral['phi'])} "
+                     f"(paper: {paper.PHI0_RANGE[0]}-{paper.PHI0_RANGE[1]})")
+    ch = s[s["q"] > 0]
+    if not ch.empty:
+        lines.append("phi vs q (ours): " + ", ".join(
+            f"q = {q:g}: {p:.4f} (phi_0/phi - 1 = {e:+.3f})"
+            for q, p, e in zip(ch["q"], ch["phi"], ch["expansion"])))
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":      # the older spelling, python3 -m granular_charged.demo ...
+    import sys
+
+    from .cli import main
+    sys.exit(main(["demo", *sys.argv[1:]]))

@@ -1,227 +1,434 @@
-"""The paper's figures from the package's own runs (PNG + CSV next to each PNG).
+"""The paper's figures from the package's own runs: PNG, with the plotted data as CSV beside it.
 
-Every function takes result dicts (runner.run_deposition / sweep.load_results; each has 'dir',
-the run folder with final.dump, forces.dump and, for tracer runs, tracer.dump) and an output
-folder, and returns the PNG path, or None when the runs needed for that figure are missing
-(the reason is printed, never papered over).
+Object-oriented matplotlib only (``Figure`` + ``FigureCanvasAgg``; no pyplot, no global backend
+switch). Every figure that has a number in the paper's text shows it beside ours
+(:mod:`granular_charged.paper`). Functions take result dicts (``Runner.deposition`` /
+``sweep.load_results``; each has ``dir``, the run folder) and an output folder and return the PNG
+path, or None when the runs needed are missing (the reason is logged).
 """
 from __future__ import annotations
 
-import csv
+import logging
 import math
-from collections import defaultdict
 from pathlib import Path
+from types import MappingProxyType
 
-import matplotlib
+import matplotlib.image as mpimg
+import numpy as np
+import pandas as pd
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.cm import ScalarMappable
+from matplotlib.collections import EllipseCollection, LineCollection
+from matplotlib.colors import BoundaryNorm, ListedColormap
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from . import packing, paper, tables
+from .params import jkr_scales, pair_modulus
 
-from . import packing  # noqa: E402
-from .params import jkr_scales, pair_modulus  # noqa: E402
+log = logging.getLogger(__name__)
 
 G2_NOTE = ("Eqs. 9-10 of the paper (Edwards volume-function equation of state) are not drawn: "
-           "they need the g_2(r, Z) model of Liu et al., Soft Matter 11 (2015) 6492, which was "
-           "not available to this package.")
+           "they need the g_2(r, Z) model of Liu et al., Soft Matter 11 (2015) 6492, which is "
+           "not implemented here.")
+PAPER_STYLE = MappingProxyType(dict(color="k", ls=":", lw=1.0))   # read-only
 
 
-def _csv(path: Path, header, rows):
-    with open(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(header)
-        w.writerows(rows)
+def new_figure(w: float, h: float) -> Figure:
+    fig = Figure(figsize=(w, h))
+    FigureCanvasAgg(fig)
+    return fig
 
 
-def _save(fig, path: Path, header, rows, tight=True):
-    """Write the figure as PNG and its data as CSV next to it (same stem), close the figure."""
+def save(fig: Figure, path: Path, data: pd.DataFrame | None = None, tight: bool = True) -> Path:
+    """PNG (130 dpi) and, when given, the plotted data as CSV with the same stem."""
     if tight:
         fig.tight_layout()
     fig.savefig(path, dpi=130)
-    plt.close(fig)
-    _csv(path.with_suffix(".csv"), header, rows)
-    return path
+    if data is not None:
+        data.to_csv(Path(path).with_suffix(".csv"), index=False)
+    return Path(path)
 
 
-def _series_key(r):
-    p = r["params"]
-    return (p["rp"], p["U0"], p["gamma"])
+def z_colormap():
+    """Colour map and norm of the coordination number: one colour per Z (paper.Z_COLORS), the
+    last for Z >= its index; the same colours LAMMPS's dump image used."""
+    n = len(paper.Z_COLORS)
+    return ListedColormap(paper.Z_COLORS), BoundaryNorm(np.arange(-0.5, n), n)
+
+
+def _z_colorbar(fig, ax):
+    cmap, norm = z_colormap()
+    n = len(paper.Z_COLORS)
+    cb = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, ticks=range(n), shrink=0.8,
+                      pad=0.02)
+    cb.ax.set_yticklabels([str(k) for k in range(n - 1)] + [f">={n - 1}"])
+    cb.set_label("coordination number Z")
+    return cb
 
 
 def _label(key):
     rp, U0, gamma = key
-    return f"r_p = {rp * 1e6:g} um, U0 = {U0:g} m/s, gamma = {gamma * 1e3:g} mJ/m2"
+    return f"r_p = {rp:g} um, U0 = {U0:g} m/s, gamma = {gamma:g} mJ/m2"
 
 
-def _group(results):
-    """(rp, U0, gamma) -> q -> list of results (seeds)."""
-    g = defaultdict(lambda: defaultdict(list))
-    for r in results:
-        if r.get("phi") is not None and not math.isnan(r["phi"]):
-            g[_series_key(r)][r["params"]["q"]].append(r)
-    return g
+def _ok(results):
+    return [r for r in results if r.get("phi") is not None and not math.isnan(r["phi"])]
 
 
-def _mean_sd(vals):
-    v = np.asarray(vals, dtype=float)
-    return float(v.mean()), float(v.std(ddof=1)) if len(v) > 1 else 0.0
+# ---- the packings (Fig. 2) ------------------------------------------------------------------
+
+def _draw_spheres(ax, snap, Z, view_axis=1):
+    """Fallback renderer (a build without dump image/PNG): orthographic side view along y,
+    spheres as discs at true size drawn far to near (painter's order), darker with depth."""
+    cmap, norm = z_colormap()
+    depth = snap["y"] if view_axis == 1 else snap["x"]
+    order = np.argsort(-depth)
+    rgb = cmap(norm(np.minimum(Z, len(paper.Z_COLORS) - 1)))[:, :3]
+    shade = 0.55 + 0.45 * (1 - (depth - depth.min()) / max(np.ptp(depth), 1e-300))
+    col = np.clip(rgb * shade[:, None], 0, 1)[order]
+    rp = float(snap["radius"].mean())
+    d = 2 * snap["radius"][order] / rp
+    ec = EllipseCollection(d, d, np.zeros_like(d), units="xy", offsets=np.column_stack(
+        [snap["x"][order] / rp, snap["z"][order] / rp]), offset_transform=ax.transData,
+        facecolors=col, edgecolors="k", linewidths=0.2)
+    ax.add_collection(ec)
+    ax.set_xlim(snap.box[0] / rp)
+    ax.set_ylim(0, float((snap["z"] + snap["radius"]).max()) / rp * 1.02)
+    ax.set_aspect("equal")
 
 
-def snapshot(result, out: Path, name="snapshot_Z.png"):
-    """Packing coloured by coordination number Z (the paper's Fig. 2)."""
-    snap = packing.read_dump(Path(result["dir"]) / "final.dump", last_only=True)
-    Z = packing.coordination(snap)
-    fig = plt.figure(figsize=(5, 6))
-    ax = fig.add_subplot(111, projection="3d")
-    rp = result["params"]["rp"]
-    sc = ax.scatter(snap["x"] / rp, snap["y"] / rp, snap["z"] / rp, c=Z, cmap="viridis",
-                    vmin=0, vmax=max(6, Z.max()), s=12, depthshade=False)
-    ax.set_xlabel("x / r_p")
-    ax.set_ylabel("y / r_p")
-    ax.set_zlabel("z / r_p")
-    ax.set_box_aspect((snap.lx, snap.ly, max(np.ptp(snap["z"]) + 2 * rp, snap.lx)))
-    fig.colorbar(sc, ax=ax, shrink=0.6, label="Z")
+def packing_image(result: dict, out: Path, name: str | None = None) -> Path:
+    """The final packing at true sphere size coloured by Z with a colour bar: LAMMPS's render
+    (packing.png of the run, dump image) framed with matplotlib; the fallback renderer when the
+    build could not render."""
     p = result["params"]
-    ax.set_title(f"q = {p['q']:g} e0, N = {p['N']}, phi = {result['phi']:.3f}, <Z> = {result['Z']:.2f}",
-                 fontsize=9)
-    return _save(fig, out / name, ["id", "x", "y", "z", "radius", "Z"],
-                 zip(snap["id"], snap["x"], snap["y"], snap["z"], snap["radius"], Z), tight=False)
+    name = name or f"packing_q{p['q']:g}_s{p['seed']}.png"
+    fig = new_figure(5.6, 5.0)
+    ax = fig.add_subplot(111)
+    _packing_panel(fig, ax, result)
+    _z_colorbar(fig, ax)
+    return save(fig, Path(out) / name)
 
+
+def _crop_white(img, pad=8):
+    """The rendered image without its white margins (dump image frames the whole box)."""
+    mask = img[..., :3].min(axis=-1) < 0.97
+    if not mask.any():
+        return img
+    r = np.flatnonzero(mask.any(axis=1))
+    c = np.flatnonzero(mask.any(axis=0))
+    return img[max(r[0] - pad, 0): r[-1] + pad + 1, max(c[0] - pad, 0): c[-1] + pad + 1]
+
+
+def _packing_panel(fig, ax, result):
+    p = result["params"]
+    img = Path(result["dir"]) / "packing.png"
+    if img.exists():
+        ax.imshow(_crop_white(mpimg.imread(img)))
+        ax.set_axis_off()
+        how = "LAMMPS dump image"
+    else:
+        snap = packing.read_dump(Path(result["dir"]) / "final.dump", last_only=True)
+        _draw_spheres(ax, snap, packing.coordination(snap))
+        ax.set_xlabel("x / r_p")
+        ax.set_ylabel("z / r_p")
+        how = "side view (no dump image in the build)"
+    ax.set_title(f"q = {p['q']:g} e0: phi = {result['phi']:.3f}, <Z> = {result['Z']:.2f}\n"
+                 f"N = {result['natoms']}, L = {p['extra'].get('L_rp', 28)} r_p ({how})",
+                 fontsize=8)
+
+
+def packings_panel(results: list[dict], out: Path) -> Path | None:
+    """The paper's Fig. 2: one packing per charge side by side (first seed of each q of the
+    series with most charges), with the paper's neutral numbers for reference."""
+    ok = _ok(results)
+    if not ok:
+        log.warning("figure packings: no finished run")
+        return None
+    df = tables.runs_frame(ok)
+    key = df.groupby(["rp_um", "U0", "gamma_mJ"])["q"].nunique().idxmax()
+    sel = df[(df[["rp_um", "U0", "gamma_mJ"]] == pd.Series(key, index=["rp_um", "U0", "gamma_mJ"])).all(axis=1)]
+    picks = sel.sort_values(["q", "seed"]).groupby("q").head(1)
+    byk = {r["key"]: r for r in ok}
+    n = len(picks)
+    fig = new_figure(3.4 * n + 1.0, 4.3)
+    axes = [fig.add_subplot(1, n, k + 1) for k in range(n)]
+    for ax, (_, row), lab in zip(axes, picks.iterrows(), "abcdefgh"):
+        _packing_panel(fig, ax, byk[row["key"]])
+        ax.set_title(f"({lab}) " + ax.get_title(), fontsize=7)
+    _z_colorbar(fig, axes)
+    fig.suptitle(f"{_label(key)}. Paper (Fig. 2, Table 2; N = 2000, L = 28 r_p): neutral "
+                 f"phi = {paper.TABLE2[0][1]}, <Z> = {paper.TABLE2[0][2]}", fontsize=8)
+    return save(fig, Path(out) / "packings.png", picks.drop(columns=["dir"]), tight=False)
+
+
+# ---- force network (Fig. 6) -----------------------------------------------------------------
+
+def read_pair_forces(final_dump: Path, forces_dump: Path):
+    """Snapshot and the pairs with a non-zero normal force: (snap, i, j, F) with i, j indices
+    into the snapshot (sorted by id), F > 0 compressive (compute pair/local 'force')."""
+    snap = packing.read_dump(final_dump, last_only=True)
+    f = packing.read_dump(forces_dump, last_only=True)
+    c = f.cols
+    if "c_pa[1]" not in c:
+        raise ValueError(f"{forces_dump}: no atom ids (c_pa[1], c_pa[2]); made by an older deck")
+    F = c["c_pl[2]"]
+    nz = F != 0.0
+    i = np.searchsorted(snap["id"], c["c_pa[1]"][nz].astype(int))
+    j = np.searchsorted(snap["id"], c["c_pa[2]"][nz].astype(int))
+    return snap, i, j, F[nz]
+
+
+def _force_panel(ax, snap, i, j, F, FC, rp, wmax, title, ztop):
+    """Lines between centres of the pairs of a slice of width 3 r_p (|y - L_y/2| <= 1.5 r_p,
+    both particles), x-z plane in units of r_p; red compressive, blue tensile, width
+    proportional to |F_n|."""
+    yc = snap.box[1].mean()
+    dy_i = snap["y"] - yc
+    dy_i -= snap.ly * np.round(dy_i / snap.ly)
+    ins = np.abs(dy_i) <= 1.5 * rp
+    keep = ins[i] & ins[j]
+    i, j, F = i[keep], j[keep], F[keep]
+    x, z = snap["x"] / rp, snap["z"] / rp
+    lx = snap.lx / rp
+    dx = x[j] - x[i]
+    dx -= lx * np.round(dx / lx)          # minimum image across the periodic x
+    seg = np.stack([np.column_stack([x[i], z[i]]), np.column_stack([x[i] + dx, z[j]])], axis=1)
+    # particles of the slice as faint outlines, for orientation
+    d = 2 * snap["radius"][ins] / rp
+    ax.add_collection(EllipseCollection(d, d, np.zeros_like(d), units="xy",
+                                        offsets=np.column_stack([x[ins], z[ins]]),
+                                        offset_transform=ax.transData, facecolors="none",
+                                        edgecolors="0.8", linewidths=0.3))
+    col = np.where(F[:, None] > 0, [[0.85, 0.1, 0.1]], [[0.1, 0.25, 0.9]])
+    lw = 0.3 + 4.0 * np.abs(F) / wmax
+    ax.add_collection(LineCollection(seg, colors=col, linewidths=lw, capstyle="round"))
+    ax.set_xlim(snap.box[0] / rp)
+    ax.set_ylim(0, ztop / rp)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x / r_p")
+    ax.set_ylabel("z / r_p")
+    ncomp, nten = int((F > 0).sum()), int((F < 0).sum())
+    ax.set_title(f"{title}\n{ncomp} compressive, {nten} tensile\ncontacts in the slice",
+                 fontsize=7)
+    return pd.DataFrame({"id_i": snap["id"][i], "id_j": snap["id"][j], "x_i_rp": x[i],
+                         "z_i_rp": z[i], "x_j_rp": x[i] + dx, "z_j_rp": z[j], "Fn": F,
+                         "Fn_over_FC": F / FC})
+
+
+def force_network(panels: list[tuple[str, Path, Path]], params: dict, out: Path,
+                  name: str = "force_network.png") -> Path | None:
+    """The paper's Fig. 6: normal contact forces in a slice of width 3 r_p as lines between
+    centres, red compressive, blue tensile, width proportional to |F_n| (one scale for all
+    panels). panels: (title, final dump, forces dump) each."""
+    loaded = []
+    for title, fd, ff in panels:
+        if not (Path(fd).exists() and Path(ff).exists()):
+            log.warning("figure %s: %s or %s missing", name, fd, ff)
+            return None
+        loaded.append((title, *read_pair_forces(fd, ff)))
+    rp = params["rp"]
+    FC = jkr_scales(rp / 2, pair_modulus(params["E"], params["nu"]), params["gamma"])["FC"]
+    wmax = max(float(np.abs(F).max()) if len(F) else 0.0 for *_, F in loaded) or 1.0
+    snap0 = loaded[0][1]
+    # top of the bed: the highest particle in a contact (one still bouncing above is left out)
+    ztop = max(float(s["z"][np.concatenate([i, j])].max() + 1.5 * rp) for _, s, i, j, _ in loaded
+               if len(i))
+    panel_w = 5.0 * snap0.lx / ztop           # panels 5 inches high, true aspect
+    fig = new_figure(min(max(len(loaded) * (panel_w + 1.2), 7.0), 16.0), 6.2)
+    frames = []
+    for k, (title, snap, i, j, F) in enumerate(loaded):
+        ax = fig.add_subplot(1, len(loaded), k + 1)
+        df = _force_panel(ax, snap, i, j, F, FC, rp, wmax, f"({'abcd'[k]}) {title}", ztop)
+        df.insert(0, "panel", title)
+        frames.append(df)
+    handles = [Line2D([], [], color=(0.85, 0.1, 0.1), lw=2, label="compressive (F_n > 0)"),
+               Line2D([], [], color=(0.1, 0.25, 0.9), lw=2, label="tensile (F_n < 0)"),
+               Line2D([], [], color="k", lw=4.3, label=f"|F_n| = {wmax / FC:.3g} F_C (widest)")]
+    fig.legend(handles=handles, loc="lower center", ncol=3, fontsize=7, frameon=False)
+    fig.suptitle("Normal contact forces in a slice of width 3 r_p (the paper's Fig. 6; paper: "
+                 f"|F_n / F_C| < {paper.FORCE_RANGE})", fontsize=9)
+    fig.tight_layout(rect=(0, 0.05, 1, 0.95))
+    return save(fig, Path(out) / name, pd.concat(frames), tight=False)
+
+
+# ---- phi, expansion, Table 2 (Fig. 3, Table 2) ------------------------------------------------
 
 def phi_vs_q(results, out: Path):
-    """phi vs q (Fig. 3) and phi_0/phi - 1 vs q on log-log with a fitted slope."""
-    g = _group(results)
-    rows, rows2 = [], []
-    fig, ax = plt.subplots(figsize=(5, 4))
-    fig2, ax2 = plt.subplots(figsize=(5, 4))
-    any_exp = False
-    for key, byq in sorted(g.items()):
-        qs = sorted(byq)
-        m = [_mean_sd([r["phi"] for r in byq[q]]) for q in qs]
-        ax.errorbar(qs, [a for a, _ in m], [b for _, b in m], marker="o", capsize=3, label=_label(key))
-        for q, (a, b) in zip(qs, m):
-            rows.append([*key, q, a, b, len(byq[q])])
-        if 0 in byq or 0.0 in byq:
-            phi0 = m[qs.index(0)][0]
-            qq = [q for q in qs if q > 0]
-            y = [phi0 / m[qs.index(q)][0] - 1.0 for q in qq]
-            pos = [(q, v) for q, v in zip(qq, y) if v > 0]
-            if pos:
-                any_exp = True
-                lq, ly = np.log10([a for a, _ in pos]), np.log10([b for _, b in pos])
-                lbl = _label(key)
-                if len(pos) >= 2:
-                    slope, icpt = np.polyfit(lq, ly, 1)
-                    xs = np.linspace(lq.min(), lq.max(), 20)
-                    ax2.plot(10 ** xs, 10 ** (slope * xs + icpt), "--", lw=1)
-                    lbl += f" (slope {slope:.2f})"
-                ax2.loglog([a for a, _ in pos], [b for _, b in pos], "o", label=lbl)
-                for q, v in zip(qq, y):
-                    rows2.append([*key, q, v])
+    """phi vs q (Fig. 3) with the paper's neutral range; phi_0/phi - 1 vs q on log-log with
+    our fitted slope and the paper's slope 2 and maximum 0.4."""
+    ok = _ok(results)
+    if not ok:
+        log.warning("figure phi_vs_q: no finished run")
+        return None, None
+    s = tables.summary(tables.runs_frame(ok))
+    fig = new_figure(5.2, 4.0)
+    ax = fig.add_subplot(111)
+    ax.axhspan(*paper.PHI0_RANGE, color="0.88", label="paper: neutral phi_0 = 0.270-0.363")
+    for key, g in s.groupby(["rp_um", "U0", "gamma_mJ"]):
+        ax.errorbar(g["q"], g["phi"], g["phi_sd"].fillna(0), marker="o", capsize=3,
+                    label=_label(key) + f" (N = {g['N'].iloc[0]:.0f})")
     ax.set_xlabel("q / e0")
     ax.set_ylabel("phi")
     ax.legend(fontsize=6)
-    p1 = _save(fig, out / "phi_vs_q.png", ["rp", "U0", "gamma", "q_e0", "phi_mean", "phi_sd", "runs"], rows)
-    p2 = None
-    if any_exp:
-        qref = np.array([50, 500])
-        ax2.loglog(qref, 1e-3 * (qref / 50) ** 2, "k:", lw=1, label="slope 2 (paper)")
-        ax2.set_xlabel("q / e0")
-        ax2.set_ylabel("phi_0 / phi - 1")
-        ax2.legend(fontsize=6)
-        fig2.tight_layout()
-        p2 = out / "expansion_loglog.png"
-        fig2.savefig(p2, dpi=130)
-        _csv(p2.with_suffix(".csv"), ["rp", "U0", "gamma", "q_e0", "phi0_over_phi_minus_1"], rows2)
-    else:
-        print("figure expansion_loglog: needs a neutral and a looser charged run of one series")
-    plt.close(fig2)
+    p1 = save(fig, Path(out) / "phi_vs_q.png", s)
+
+    sl = tables.expansion_slope(s)
+    pos = s[(s["q"] > 0) & (s["expansion"] > 0)]
+    if pos.empty:
+        log.warning("figure expansion_loglog: needs a neutral run and a looser charged run "
+                    "of one series")
+        return p1, None
+    fig = new_figure(5.2, 4.0)
+    ax = fig.add_subplot(111)
+    for key, g in pos.groupby(["rp_um", "U0", "gamma_mJ"]):
+        m = sl[(sl[["rp_um", "U0", "gamma_mJ"]] == key).all(axis=1)]
+        slope = float(m["slope"].iloc[0]) if len(m) else float("nan")
+        lbl = _label(key) + (f": fitted slope {slope:.2f}" if np.isfinite(slope) else "")
+        ax.loglog(g["q"], g["expansion"], "o", label=lbl)
+        # the paper's slope 2 through the geometric centre of our points
+        lq, le = np.log10(g["q"]).mean(), np.log10(g["expansion"]).mean()
+        qq = np.array([g["q"].min() / 1.5, g["q"].max() * 1.5])
+        ax.loglog(qq, 10 ** (le + paper.EXPANSION_SLOPE * (np.log10(qq) - lq)), **PAPER_STYLE)
+    ax.plot([], [], **PAPER_STYLE, label="paper: slope 2 (through our points)")
+    ax.axhline(paper.MAX_RELATIVE_DECREASE, color="0.5", ls="--", lw=0.8,
+               label="paper: maximum phi_0/phi - 1 = 0.4")
+    ax.set_xlabel("q / e0")
+    ax.set_ylabel("phi_0 / phi - 1")
+    ax.legend(fontsize=6)
+    p2 = save(fig, Path(out) / "expansion_loglog.png", pos.merge(sl, how="left"))
     return p1, p2
 
 
-def rdf(results, out: Path, nbins=150):
-    """g(r) of the analysis slab, neutral vs the most charged run of one series (Fig. 4)."""
-    g = _group(results)
-    if not g:
-        print("figure rdf: no run with an analysis slab")
+def table2(rows: list[dict], out: Path) -> Path | None:
+    """The charged-after-formation check (Table 2): phi and <Z> before and after charging,
+    ours and the paper's."""
+    if not rows:
         return None
-    key = max(g, key=lambda k: (len(g[k]), k))
-    byq = g[key]
-    qs = sorted(byq)
-    pick = [qs[0]] + ([qs[-1]] if len(qs) > 1 else [])
-    fig, ax = plt.subplots(figsize=(5, 4))
-    cols = {}
-    for q in pick:
+    df = tables.table2_frame(rows)
+    fig = new_figure(7.5, 3.4)
+    a1, a2 = fig.add_subplot(121), fig.add_subplot(122)
+    for ax, k, ref in ((a1, "phi", "paper_phi"), (a2, "Z", "paper_Z")):
+        ax.plot(df["q"], df[f"{k}_before"], "o", mfc="none", ms=9, label="ours, before charging")
+        ax.plot(df["q"], df[f"{k}_after"], "x", ms=8, label="ours, after charging + relaxing")
+        pq, pv = [t[0] for t in paper.TABLE2], [t[1 if k == "phi" else 2] for t in paper.TABLE2]
+        ax.plot(pq, pv, "k*", ms=9, label="paper Table 2 (N = 2000)")
+        ax.set_xlabel("q / e0 (given after formation)")
+        ax.set_ylabel("phi" if k == "phi" else "<Z>")
+        lo = min(min(pv), df[f"{k}_before"].min())
+        hi = max(max(pv), df[f"{k}_before"].max())
+        ax.set_ylim(lo - 0.15 * (hi - lo) - 0.01, hi + 0.35 * (hi - lo) + 0.01)
+    a1.legend(fontsize=6, loc="upper left")
+    a2.set_title(f"max |d<Z>| = {df['dZ'].abs().max():.2g}", fontsize=8)
+    a1.set_title(f"max |dphi| = {df['dphi'].abs().max():.2g}", fontsize=8)
+    return save(fig, Path(out) / "table2.png", df)
+
+
+# ---- structure (Figs. 4, 5, 7) -------------------------------------------------------------
+
+def _biggest_series(ok):
+    df = tables.runs_frame(ok)
+    key = df.groupby(["rp_um", "U0", "gamma_mJ"])["q"].nunique().idxmax()
+    sel = [r for r in ok if (r["params"]["rp"] * 1e6, r["params"]["U0"],
+                             r["params"]["gamma"] * 1e3) == key]
+    byq = {}
+    for r in sel:
+        byq.setdefault(r["params"]["q"], []).append(r)
+    return key, dict(sorted(byq.items()))
+
+
+def rdf(results, out: Path, nbins=150):
+    """g(r) of the analysis slab, neutral vs the most charged case of one series (Fig. 4)."""
+    ok = _ok(results)
+    if not ok:
+        log.warning("figure rdf: no run with an analysis slab")
+        return None
+    key, byq = _biggest_series(ok)
+    qs = list(byq)
+    fig = new_figure(5.2, 4.0)
+    ax = fig.add_subplot(111)
+    data = {}
+    for q in [qs[0]] + ([qs[-1]] if len(qs) > 1 else []):
         gs = []
         for r in byq[q]:
             snap = packing.read_dump(Path(r["dir"]) / "final.dump", last_only=True)
             rp = r["params"]["rp"]
             rc, gr = packing.rdf_slab(snap, r["zlo"], r["zhi"], 6.0 * rp, nbins)
             gs.append(gr)
-        gm = np.mean(gs, axis=0)
         x = rc / (2 * rp)
-        ax.plot(x, gm, label=f"q = {q:g} e0 ({len(gs)} runs)")
-        cols[q] = gm
-    for v in (1.0, math.sqrt(3), 2.0):
+        data["r_over_2rp"] = x
+        data[f"g_q{q:g}"] = np.mean(gs, axis=0)
+        ax.plot(x, data[f"g_q{q:g}"], label=f"q = {q:g} e0 ({len(gs)} runs)")
+    for v, t in ((1.0, "1"), (math.sqrt(3), "sqrt 3"), (2.0, "2")):
         ax.axvline(v, color="grey", lw=0.5, ls=":")
+        ax.text(v, 0.98, t, transform=ax.get_xaxis_transform(), fontsize=6, ha="center", va="top")
     ax.set_xlabel("r / 2r_p")
     ax.set_ylabel("g(r)")
     ax.set_xlim(0.8, 3.0)
-    ax.set_title(_label(key), fontsize=8)
+    ax.set_title(_label(key) + "\npaper (Fig. 4): the sqrt 3 peak vanishes when charged", fontsize=8)
     ax.legend(fontsize=7)
-    path = _save(fig, out / "rdf.png", ["r_over_2rp"] + [f"g_q{q:g}" for q in cols],
-                 zip(x, *cols.values()))
-    return path
+    return save(fig, Path(out) / "rdf.png", pd.DataFrame(data))
 
 
 def fZ(results, out: Path):
-    """Coordination-number distribution f(Z) vs q (Fig. 5)."""
-    g = _group(results)
-    fig, ax = plt.subplots(figsize=(5, 4))
+    """Coordination-number distribution f(Z) per case (Fig. 5), with the paper's neutral <Z>."""
+    ok = _ok(results)
+    if not ok:
+        return None
+    fig = new_figure(5.2, 4.0)
+    ax = fig.add_subplot(111)
     rows = []
-    for key, byq in sorted(g.items()):
-        for q in sorted(byq):
-            f = np.mean([np.pad(r["fZ"], (0, 13 - len(r["fZ"]))) for r in byq[q]], axis=0)
-            ax.plot(range(len(f)), f, marker="o", label=f"{_label(key)}, q = {q:g}")
-            rows.append([*key, q] + list(f))
-    ax.set_xlabel("Z")
+    groups = {}
+    for r in ok:
+        p = r["params"]
+        groups.setdefault((p["rp"] * 1e6, p["U0"], p["gamma"] * 1e3, p["q"]), []).append(r)
+    for (rp, U0, gam, q), rs in sorted(groups.items()):
+        n = max(len(r["fZ"]) for r in rs)
+        f = np.mean([np.pad(r["fZ"], (0, n - len(r["fZ"]))) for r in rs], axis=0)
+        Zm = float(np.mean([r["Z"] for r in rs]))
+        line, = ax.plot(range(n), f, marker="o", ms=3,
+                        label=f"{_label((rp, U0, gam))}, q = {q:g}: <Z> = {Zm:.2f}")
+        ax.axvline(Zm, color=line.get_color(), lw=0.6, ls="--")
+        rows.append(dict(rp_um=rp, U0=U0, gamma_mJ=gam, q=q, runs=len(rs), Z=Zm,
+                         **{f"f{z}": v for z, v in enumerate(f)}))
+    ax.axvline(paper.TABLE2[0][2], **PAPER_STYLE)
+    ax.plot([], [], **PAPER_STYLE, label=f"paper Table 2 neutral <Z> = {paper.TABLE2[0][2]}")
+    ax.set_xlabel("Z (last bin of compute coord/dist: Z >= zmax)")
     ax.set_ylabel("f(Z)")
     ax.set_xlim(-0.5, 10.5)
     ax.legend(fontsize=5)
-    path = _save(fig, out / "fZ.png", ["rp", "U0", "gamma", "q_e0"] + [f"f{z}" for z in range(13)], rows)
-    return path
+    return save(fig, Path(out) / "fZ.png", pd.DataFrame(rows))
 
 
-def force_pdf(results, out: Path, bins=60):
-    """pdf of the normal contact forces F_n / F_C (Fig. 7), from compute pair/local (the
-    deck's forces.dump: distance, signed normal force, > 0 repulsive), all particle pairs."""
-    g = _group(results)
-    if not g:
-        print("figure force_pdf: no run with an analysis slab")
-        return None
-    key = max(g, key=lambda k: (len(g[k]), k))
-    fig, ax = plt.subplots(figsize=(5, 4))
+def force_pdf(panels: list[tuple[str, Path]], params: dict, out: Path, name="force_pdf.png",
+              bins=60):
+    """pdf of the normal contact forces F_n / F_C (Fig. 7) of forces dumps (compute pair/local:
+    signed normal force, > 0 compressive), pairs in contact only; the paper's range |F_n/F_C|
+    < 0.1 marked. panels: (label, forces dump) each."""
+    FC = jkr_scales(params["rp"] / 2, pair_modulus(params["E"], params["nu"]), params["gamma"])["FC"]
+    fig = new_figure(5.2, 4.0)
+    ax = fig.add_subplot(111)
     edges = np.linspace(-0.2, 0.2, bins + 1)
-    cols = {}
-    for q in sorted(g[key]):
-        vals = []
-        for r in g[key][q]:
-            p = r["params"]
-            FC = jkr_scales(p["rp"] / 2, pair_modulus(p["E"], p["nu"]), p["gamma"])["FC"]
-            s = packing.read_dump(Path(r["dir"]) / "forces.dump", last_only=True)
-            f = s.cols.get("c_pl[2]", np.zeros(0))
-            vals.append(f[f != 0.0] / FC)
-        v = np.concatenate(vals) if vals else np.zeros(0)
+    c = 0.5 * (edges[1:] + edges[:-1])
+    data = {"Fn_over_FC": c}
+    for label, path in panels:
+        if not Path(path).exists():
+            log.warning("figure %s: %s missing", name, path)
+            return None
+        s = packing.read_dump(path, last_only=True)
+        f = s.cols["c_pl[2]"]
+        v = f[f != 0.0] / FC
         h, _ = np.histogram(v, bins=edges, density=True)
-        c = 0.5 * (edges[1:] + edges[:-1])
-        ax.plot(c, h, label=f"q = {q:g} e0 ({len(v)} contacts)")
-        cols[q] = h
+        ax.plot(c, h, label=f"{label} ({len(v)} contacts, mean {v.mean():+.4f})")
+        data[f"pdf {label}"] = h
+    for x in (-paper.FORCE_RANGE, paper.FORCE_RANGE):
+        ax.axvline(x, **PAPER_STYLE)
+    ax.plot([], [], **PAPER_STYLE, label="paper: |F_n / F_C| < 0.1")
     ax.set_xlabel("F_n / F_C  (> 0 compressive)")
     ax.set_ylabel("pdf")
-    ax.set_title(_label(key), fontsize=8)
-    ax.legend(fontsize=7)
-    path = _save(fig, out / "force_pdf.png", ["Fn_over_FC"] + [f"pdf_q{q:g}" for q in cols], zip(c, *cols.values()))
-    return path
+    ax.legend(fontsize=6)
+    return save(fig, Path(out) / name, pd.DataFrame(data))
 
 
 def tracer_energy(results, out: Path):
@@ -230,116 +437,130 @@ def tracer_energy(results, out: Path):
     before the tracer: hit-and-stick keeps them where they were when the tracer came)."""
     runs = [r for r in results if r.get("tracer") and (Path(r["dir"]) / "tracer.dump").exists()]
     if not runs:
-        print("figure tracer_energy: no run with a tracer particle")
+        log.warning("figure tracer_energy: no run with a tracer particle")
         return None
-    fig, ax = plt.subplots(figsize=(5, 4))
-    rows = []
+    fig = new_figure(5.2, 4.0)
+    ax = fig.add_subplot(111)
+    frames = []
     for r in sorted(runs, key=lambda r: r["params"]["q"]):
         p = r["params"]
         tid = r["tracer"]
-        tr = packing.read_dump(Path(r["dir"]) / "tracer.dump")
-        tr = [s for s in tr if s.n == 1]
+        tr = [s for s in packing.read_dump(Path(r["dir"]) / "tracer.dump") if s.n == 1]
         fin = packing.read_dump(Path(r["dir"]) / "final.dump", last_only=True)
         bed = fin["id"] < tid
-        bx, by, bz = fin["x"][bed], fin["y"][bed], fin["z"][bed]
+        if not tr:
+            continue
+        pos = np.array([[s["x"][0], s["y"][0], s["z"][0]] for s in tr])
+        vel = np.array([[s["vx"][0], s["vy"][0], s["vz"][0]] for s in tr])
+        d = pos[:, None, :] - np.column_stack([fin["x"][bed], fin["y"][bed], fin["z"][bed]])[None]
+        d[..., 0] -= fin.lx * np.round(d[..., 0] / fin.lx)
+        d[..., 1] -= fin.ly * np.round(d[..., 1] / fin.ly)
+        # gap to the nearest earlier particle or to the floor (z = 0), whichever is closer
+        near = (np.sqrt((d * d).sum(-1)).min(axis=1) if bed.any()
+                else np.full(len(pos), np.inf))
+        gaps = np.minimum(near - 2 * p["rp"], pos[:, 2] - p["rp"]) / p["rp"]
         m = 4.0 / 3.0 * math.pi * p["rp"] ** 3 * p["rho"]
-        ek0 = 0.5 * m * p["U0"] ** 2
-        gaps, eks = [], []
-        for s in tr:
-            dx = bx - s["x"][0]
-            dy = by - s["y"][0]
-            dx -= fin.lx * np.round(dx / fin.lx)
-            dy -= fin.ly * np.round(dy / fin.ly)
-            d = np.sqrt(dx * dx + dy * dy + (bz - s["z"][0]) ** 2).min() if len(bx) else s["z"][0]
-            gaps.append((d - 2 * p["rp"]) / p["rp"])
-            eks.append(0.5 * m * (s["vx"][0] ** 2 + s["vy"][0] ** 2 + s["vz"][0] ** 2) / ek0)
-            rows.append([p["q"], gaps[-1], eks[-1]])
-        # until the first contact
-        k = next((i for i, gp in enumerate(gaps) if gp <= 0), len(gaps))
-        ax.plot(gaps[: k + 1], eks[: k + 1], label=f"q = {p['q']:g} e0 (particle {tid})")
+        eks = 0.5 * m * (vel * vel).sum(1) / (0.5 * m * p["U0"] ** 2)
+        # first contact: the first jump of E_k between samples (> 1 % of E_k0; in free flight,
+        # gravity and the Coulomb field change it by ~1e-4 per sample). The gap is measured to
+        # the final positions of the earlier particles, which may have moved since
+        jumps = np.flatnonzero(np.abs(np.diff(eks)) > 0.01)
+        k = int(jumps[0]) + 1 if len(jumps) else len(eks) - 1
+        line, = ax.plot(gaps[: k + 1], eks[: k + 1], label=f"q = {p['q']:g} e0 (particle {tid}): "
+                        f"E_k/E_k0 = {eks[k - 1]:.3f} before the first contact")
+        ax.plot(gaps[k - 1], eks[k - 1], "o", color=line.get_color())
+        frames.append(pd.DataFrame({"q": p["q"], "gap_over_rp": gaps, "Ek_over_Ek0": eks}))
     ax.axvline(0, color="grey", ls="--", lw=0.8)
     ax.set_xscale("symlog", linthresh=0.1)
-    ax.set_xlabel("gap to nearest deposited particle / r_p")
+    ax.set_xlabel("gap to the nearest deposited particle or the floor / r_p")
     ax.set_ylabel("E_k / E_k0")
     ax.legend(fontsize=7)
-    path = _save(fig, out / "tracer_energy.png", ["q_e0", "gap_over_rp", "Ek_over_Ek0"], rows)
-    return path
+    return save(fig, Path(out) / "tracer_energy.png", pd.concat(frames) if frames else None)
 
 
 def vs_adstar(results, out: Path):
-    """phi and <Z> vs Ad* (Fig. 9), and the Z-phi plane with the ALP point (Fig. 10)."""
-    ok = [r for r in results if r.get("phi") is not None and not math.isnan(r["phi"])
-          and math.isfinite(r["groups"]["Adstar"])]
+    """phi and <Z> vs Ad* (Fig. 9) with the ALP limits, and the Z-phi plane (Fig. 10) with the
+    ALP point and the paper's Table 2 neutral packing."""
+    ok = [r for r in _ok(results) if math.isfinite(r["groups"]["Adstar"])]
     if not ok:
         return None, None
-    ad = np.array([r["groups"]["Adstar"] for r in ok])
-    phi = np.array([r["phi"] for r in ok])
-    Z = np.array([r["Z"] for r in ok])
-    q = np.array([r["params"]["q"] for r in ok])
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(5, 6), sharex=True)
-    sc = a1.scatter(ad, phi, c=q, cmap="plasma")
-    a2.scatter(ad, Z, c=q, cmap="plasma")
-    a1.axhline(1 / 8, color="grey", ls=":", lw=1)
-    a2.axhline(2, color="grey", ls=":", lw=1)
-    a1.set_xscale("log")
+    df = tables.runs_frame(ok)
+    fig = new_figure(5.2, 6.0)
+    a1, a2 = fig.add_subplot(211), fig.add_subplot(212, sharex=None)
+    sc = a1.scatter(df["Adstar"], df["phi"], c=df["q"], cmap="plasma")
+    a2.scatter(df["Adstar"], df["Z"], c=df["q"], cmap="plasma")
+    a1.axhline(paper.ALP_PHI, **PAPER_STYLE, label="paper: ALP limit phi = 1/8")
+    a2.axhline(paper.ALP_Z, **PAPER_STYLE, label="paper: ALP limit <Z> = 2")
+    for ax in (a1, a2):
+        ax.set_xscale("log")
+        ax.axvline(1.0, color="0.6", lw=0.8, ls="--")
+        ax.legend(fontsize=6, loc="lower left")
     a1.set_ylabel("phi")
     a2.set_ylabel("<Z>")
-    a2.set_xlabel("Ad*")
+    a2.set_xlabel("Ad* (paper: all its cases have Ad* > 1)")
     fig.colorbar(sc, ax=[a1, a2], label="q / e0")
-    p1 = out / "phi_Z_vs_Adstar.png"
-    fig.savefig(p1, dpi=130)
-    plt.close(fig)
-    rows = [[r["params"]["rp"], r["params"]["U0"], r["params"]["gamma"], r["params"]["q"],
-             r["params"]["seed"], r["groups"]["Ad"], r["groups"]["Estar"], r["groups"]["Adstar"],
-             r["phi"], r["Z"]] for r in ok]
-    hdr = ["rp", "U0", "gamma", "q_e0", "seed", "Ad", "Estar", "Adstar", "phi", "Z"]
-    _csv(p1.with_suffix(".csv"), hdr, rows)
+    p1 = save(fig, Path(out) / "phi_Z_vs_Adstar.png", df.drop(columns=["dir"]), tight=False)
 
-    fig, ax = plt.subplots(figsize=(5, 4.6))
-    sc = ax.scatter(Z, phi, c=q, cmap="plasma", label="this package's runs")
-    ax.plot([2], [1 / 8], "k*", ms=12, label="ALP (Z = 2, phi = 1/8)")
+    fig = new_figure(5.2, 4.8)
+    ax = fig.add_subplot(111)
+    sc = ax.scatter(df["Z"], df["phi"], c=df["q"], cmap="plasma", label="this package's runs")
+    ax.plot([paper.ALP_Z], [paper.ALP_PHI], "k*", ms=12, label="paper: ALP (Z = 2, phi = 1/8)")
+    ax.plot([paper.TABLE2[0][2]], [paper.TABLE2[0][1]], "ks", mfc="none", ms=8,
+            label="paper Table 2 neutral packing")
     ax.set_xlim(1.5, 6.5)
     ax.set_ylim(0.1, 0.65)
     ax.set_xlabel("<Z>")
     ax.set_ylabel("phi")
     fig.colorbar(sc, ax=ax, label="q / e0")
     ax.legend(fontsize=7, loc="upper left")
-    fig.text(0.01, 0.005, "\n".join(_wrap(G2_NOTE, 95)), fontsize=5.5, va="bottom")
+    fig.text(0.01, 0.005, G2_NOTE, fontsize=5.5, va="bottom", wrap=True)
     fig.subplots_adjust(bottom=0.2)
-    p2 = _save(fig, out / "phase_diagram_Z_phi.png", hdr, rows, tight=False)
+    p2 = save(fig, Path(out) / "phase_diagram_Z_phi.png", df.drop(columns=["dir"]), tight=False)
     return p1, p2
 
 
-def _wrap(s, n):
-    words, lines, cur = s.split(), [], ""
-    for w in words:
-        if len(cur) + len(w) + 1 > n:
-            lines.append(cur)
-            cur = w
-        else:
-            cur = (cur + " " + w).strip()
-    return lines + [cur]
+# ---- everything -----------------------------------------------------------------------------
 
-
-def all_figures(results, out: Path) -> list[Path]:
+def all_figures(results, out: Path, table2_rows: list[dict] | None = None,
+                table2_dir: Path | None = None) -> list[Path]:
     """Every figure the given runs allow; returns the PNG paths written."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     results = [r for r in results if r.get("complete")]
-    paths = []
+    paths: list[Path | None] = []
     if not results:
-        print("figures: no finished runs")
-        return paths
-    g = _group(results)
-    for key, byq in g.items():
-        for qv in sorted(byq):
-            r = byq[qv][0]
-            p = r["params"]
-            paths.append(snapshot(r, out, f"snapshot_Z_rp{p['rp'] * 1e6:g}_U{p['U0']:g}_"
-                                          f"g{p['gamma'] * 1e3:g}_q{qv:g}.png"))
-    for f in (phi_vs_q, rdf, fZ, force_pdf, tracer_energy, vs_adstar):
-        r = f(results, out)
-        for p in (r if isinstance(r, tuple) else (r,)):
-            if p is not None:
-                paths.append(p)
-    return paths
+        log.warning("figures: no finished runs")
+        return []
+    ok = _ok(results)
+    for r in ok:
+        paths.append(packing_image(r, out))
+    paths.append(packings_panel(results, out))
+    p = phi_vs_q(results, out)
+    paths += list(p) if isinstance(p, tuple) else [p]
+    paths += [rdf(results, out), fZ(results, out), tracer_energy(results, out)]
+    paths += list(vs_adstar(results, out))
+    if ok:
+        key, byq = _biggest_series(ok)
+        qs = list(byq)
+        picks = [byq[qs[0]][0]] + ([byq[qs[-1]][0]] if len(qs) > 1 else [])
+        params = picks[0]["params"]
+        paths.append(force_network(
+            [(f"deposited with q = {r['params']['q']:g} e0", Path(r["dir"]) / "final.dump",
+              Path(r["dir"]) / "forces.dump") for r in picks], params, out,
+            "force_network_deposition.png"))
+        paths.append(force_pdf([(f"deposited with q = {q:g} e0", Path(r["dir"]) / "forces.dump")
+                                for q in qs for r in byq[q][:1]], params, out))
+    if table2_rows:
+        paths.append(table2(table2_rows, out))
+        # the paper's Figs. 6 and 7 proper: the Table 2 packing before and after charging
+        last = max(table2_rows, key=lambda r: r["q"])
+        d = Path(last["dir"])
+        params = last["params"]
+        paths.append(force_network(
+            [("neutral packing (formed with q = 0)", d / "before.dump", d / "forces_before.dump"),
+             (f"after charging to q = {last['q']:g} e0 and relaxing", d / "after.dump",
+              d / "forces_after.dump")], params, out, "force_network.png"))
+        paths.append(force_pdf([("neutral packing", d / "forces_before.dump"),
+                                (f"charged after formation, q = {last['q']:g} e0",
+                                 d / "forces_after.dump")], params, out, "force_pdf_table2.png"))
+    return [p for p in paths if p is not None]

@@ -89,7 +89,8 @@ def sphere_slab_volume(zc, r, zlo, zhi):
     """Exact volume of spheres (centres zc, radii r) between the planes z = zlo and z = zhi:
     int_{max(zlo, zc - r)}^{min(zhi, zc + r)} pi (r^2 - (s - zc)^2) ds. Vectorised."""
     zc = np.asarray(zc, dtype=float)
-    r = np.broadcast_to(np.asarray(r, dtype=float), zc.shape)
+    r = np.asarray(r, dtype=float)
+    zc, r, zlo, zhi = np.broadcast_arrays(zc, r, np.asarray(zlo, float), np.asarray(zhi, float))
     u1 = np.clip(zlo - zc, -r, r)
     u2 = np.clip(zhi - zc, -r, r)
     F = lambda u: math.pi * (r * r * u - u ** 3 / 3.0)
@@ -103,10 +104,16 @@ def phi_slab(snap: Snapshot, zlo: float, zhi: float) -> float:
 
 
 def phi_profile(snap: Snapshot, dz: float, zmax: float | None = None):
-    """phi(z) in bins of width dz from z = 0: returns (bin centres, phi)."""
+    """phi(z) in bins of width dz from z = 0: returns (bin centres, phi).
+
+    Vectorised: the sphere volume below each bin edge, V(z_k) = sum_i vol_i(-inf, z_k), is one
+    (N x bins) array; the volume in bin k is V(z_{k+1}) - V(z_k), so each sphere's volume is
+    split exactly between the bins it crosses."""
     zmax = zmax if zmax is not None else float(np.max(snap["z"] + snap["radius"]))
     edges = np.arange(0.0, zmax + dz, dz)
-    phi = np.array([phi_slab(snap, a, b) for a, b in zip(edges[:-1], edges[1:])])
+    below = sphere_slab_volume(snap["z"][:, None], snap["radius"][:, None], -np.inf,
+                               edges[None, :]).sum(axis=0)
+    phi = np.diff(below) / (snap.lx * snap.ly * np.diff(edges))
     return 0.5 * (edges[:-1] + edges[1:]), phi
 
 
@@ -120,37 +127,40 @@ def analysis_slab(snap: Snapshot, rp: float, zlo_rp: float = 4.0, top_rp: float 
 
 
 def surface_heights(snap: Snapshot, cell: float):
-    """Highest sphere top (z + r) in each column of a cell x cell grid (nan where empty)."""
+    """Highest sphere top (z + r) in each column of a cell x cell grid (nan where empty),
+    shape (nx, ny); vectorised with an unbuffered maximum (np.fmax.at)."""
     nx = max(1, int(round(snap.lx / cell)))
     ny = max(1, int(round(snap.ly / cell)))
     ix = np.floor((snap["x"] - snap.box[0, 0]) / snap.lx * nx).astype(int) % nx
     iy = np.floor((snap["y"] - snap.box[1, 0]) / snap.ly * ny).astype(int) % ny
-    top = np.full((nx, ny), np.nan)
-    for a, b, t in zip(ix, iy, snap["z"] + snap["radius"]):
-        if not (t <= top[a, b]):
-            top[a, b] = t
-    return top
+    top = np.full(nx * ny, -np.inf)
+    np.fmax.at(top, ix * ny + iy, snap["z"] + snap["radius"])
+    top[np.isneginf(top)] = np.nan
+    return top.reshape(nx, ny)
 
 
 # ---- contacts -------------------------------------------------------------------------------
 
-def _tree(snap: Snapshot):
+def periodic_tree(snap: Snapshot, rcut: float):
+    """cKDTree of the centres with the box's periodicity: x, y wrap with the box lengths; the
+    open z axis is shifted to start at 0 and given a period longer than the bed's height plus
+    2 rcut, so no pair closer than rcut is ever found through a z "image". Returns
+    (tree, wrapped coordinates)."""
     xyz = snap.xyz.copy()
     xyz[:, 0] = np.mod(xyz[:, 0] - snap.box[0, 0], snap.lx)
     xyz[:, 1] = np.mod(xyz[:, 1] - snap.box[1, 0], snap.ly)
-    zmin = xyz[:, 2].min()
-    xyz[:, 2] -= zmin
-    bz = 4.0 * (xyz[:, 2].max() + 1.0) + 10.0 * snap.lx     # no wrap in z
-    # cKDTree needs 0 <= x < boxsize
+    # np.mod can return exactly L for -tiny inputs; cKDTree needs 0 <= x < boxsize
     xyz[:, 0] = np.where(xyz[:, 0] >= snap.lx, 0.0, xyz[:, 0])
     xyz[:, 1] = np.where(xyz[:, 1] >= snap.ly, 0.0, xyz[:, 1])
+    xyz[:, 2] -= xyz[:, 2].min() if len(xyz) else 0.0
+    bz = (xyz[:, 2].max() if len(xyz) else 0.0) + 2.0 * rcut + 1.0 * max(snap.lx, snap.ly)
     return cKDTree(xyz, boxsize=[snap.lx, snap.ly, bz]), xyz
 
 
 def pair_distances(snap: Snapshot, rcut: float):
-    """All pairs (i < j, indices into the snapshot) closer than rcut, with distances (x, y
-    periodic, z open)."""
-    tree, xyz = _tree(snap)
+    """All pairs (i < j, indices into the snapshot) with r_ij <= rcut, with distances (x, y
+    periodic by the minimum image, z open)."""
+    tree, xyz = periodic_tree(snap, rcut)
     pairs = tree.query_pairs(rcut, output_type="ndarray")
     if len(pairs) == 0:
         return pairs.reshape(0, 2), np.zeros(0)
@@ -161,14 +171,15 @@ def pair_distances(snap: Snapshot, rcut: float):
 
 
 def contacts(snap: Snapshot, tol: float = 0.0):
-    """Geometric contacts: pairs with r_ij < r_i + r_j + tol (tol = 0: overlap, the paper's
-    'geometrical contact'). Returns (pairs, overlaps delta = r_i + r_j - r_ij)."""
+    """Geometric contacts, the definition of LAMMPS ``compute coord/dist contact geometric``
+    (doc/compute_coord_dist.md): r_ij <= r_i + r_j + tol (tol = 0: touching or overlapping, the
+    paper's 'geometrical contact'). Returns (pairs, overlaps delta = r_i + r_j - r_ij)."""
     rad = snap["radius"]
     pairs, dist = pair_distances(snap, 2.0 * rad.max() + tol)
     if len(pairs) == 0:
         return pairs, dist
     ov = rad[pairs[:, 0]] + rad[pairs[:, 1]] - dist
-    keep = ov > -tol
+    keep = ov >= -tol
     return pairs[keep], ov[keep]
 
 
@@ -181,13 +192,27 @@ def coordination(snap: Snapshot, tol: float = 0.0) -> np.ndarray:
     return Z
 
 
-def coordination_stats(snap: Snapshot, zlo: float, zhi: float, tol: float = 0.0, zmax_bins=12):
-    """<Z> and f(Z) over the particles whose centres lie in [zlo, zhi]."""
+ZMAX_DEFAULT = 20   # compute coord/dist's default zmax
+
+
+def fz_histogram(Z, zmax: int = ZMAX_DEFAULT) -> np.ndarray:
+    """f(Z) as compute coord/dist defines it: zmax + 1 bins Z = 0 .. zmax, the last one counting
+    every Z >= zmax (so f sums to 1 whatever the largest Z); fractions of len(Z)."""
+    Z = np.asarray(Z, dtype=int)
+    f = np.bincount(np.minimum(Z, zmax), minlength=zmax + 1).astype(float)
+    return f / max(len(Z), 1)
+
+
+def coordination_stats(snap: Snapshot, zlo: float, zhi: float, tol: float = 0.0,
+                       zmax: int = ZMAX_DEFAULT):
+    """<Z> and f(Z) over the particles whose centres lie in [zlo, zhi], with the definitions of
+    ``compute coord/dist z zlo zhi contact geometric tolerance tol zmax zmax``: contacts by
+    :func:`contacts`, f(Z) by :func:`fz_histogram` (Z >= zmax in the last bin), <Z> from the
+    true Z."""
     Z = coordination(snap, tol)
     sel = (snap["z"] >= zlo) & (snap["z"] <= zhi)
     Zs = Z[sel]
-    f = np.bincount(Zs, minlength=zmax_bins + 1)[: zmax_bins + 1].astype(float)
-    f /= max(len(Zs), 1)
+    f = fz_histogram(Zs, zmax)
     return {"Z": float(Zs.mean()) if len(Zs) else float("nan"), "fZ": f.tolist(),
             "n_slab": int(sel.sum()), "Z_all": Z}
 
@@ -216,7 +241,7 @@ def analyse(snap: Snapshot, rp: float, zlo_rp=4.0, top_rp=6.0, tol=0.0) -> dict:
     """phi, <Z>, f(Z) of the analysis slab of a final snapshot (the decks' rule)."""
     zlo, zhi = analysis_slab(snap, rp, zlo_rp, top_rp)
     out = {"zlo": zlo, "zhi": zhi, "slab_thickness_rp": (zhi - zlo) / rp}
-    if zhi - zlo < 2.0 * rp:
+    if zhi <= zlo:      # in.deposition's rule (slab_ok): a slab exists when zhi > zlo
         out.update({"phi": float("nan"), "Z": float("nan"), "fZ": [], "n_slab": 0,
                     "warning": "bed too thin for the analysis slab"})
         return out
