@@ -276,12 +276,22 @@ def phi_vs_q(results, out: Path):
 
     sl = tables.expansion_slope(s)
     pos = s[(s["q"] > 0) & (s["expansion"] > 0)]
-    if pos.empty:
-        log.warning("figure expansion_loglog: needs a neutral run and a looser charged run "
-                    "of one series")
-        return p1, None
     fig = new_figure(5.2, 4.0)
     ax = fig.add_subplot(111)
+    if pos.empty:
+        # still a figure (with the paper's reference), saying why there are no points: a
+        # log-log plot needs a neutral run and a looser charged run of one series
+        log.warning("figure expansion_loglog: no charged run is looser than its neutral run")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.text(0.5, 0.5, "no charged run looser than its neutral run\n(phi_0/phi - 1 <= 0)",
+                transform=ax.transAxes, ha="center", va="center", fontsize=9)
+        ax.axhline(paper.MAX_RELATIVE_DECREASE, color="0.5", ls="--", lw=0.8,
+                   label="paper: maximum phi_0/phi - 1 = 0.4")
+        ax.set_xlabel("q / e0")
+        ax.set_ylabel("phi_0 / phi - 1")
+        ax.legend(fontsize=6)
+        return p1, save(fig, Path(out) / "expansion_loglog.png", s)
     for key, g in pos.groupby(["rp_um", "U0", "gamma_mJ"]):
         m = sl[(sl[["rp_um", "U0", "gamma_mJ"]] == key).all(axis=1)]
         slope = float(m["slope"].iloc[0]) if len(m) else float("nan")
