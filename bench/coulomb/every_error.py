@@ -3,7 +3,7 @@
 applied, so the force error after k steps is |q (E(t0 + k dt) - E(t0))|. Measured on the
 deposition geometry (bench_coulomb.py's data, N = 2000, q = 400 e_0, r_p = 1 um) with particles
 moving at the paper's injection speed U_0 = 1 m/s in random directions and dt = 2e-9 s (the
-contact-resolving step of the paper's set-up, physics.md sec. 1).
+contact-resolving step of the paper's set-up, doc/theory.md, eq. (1.10)).
 
 Usage: . build/env.sh && /usr/bin/python3 bench/coulomb/every_error.py
 """

@@ -1,5 +1,4 @@
-"""Numbers stated in the text of Chen, Li, Liu & Makse, Soft Matter 2016 (arXiv:1509.07012;
-/work/shared/reference/paper-charged-adhesive-packing.txt), shown beside ours in the figures,
+"""Numbers stated in the text of Chen, Li, Liu & Makse, Soft Matter 2016 (arXiv:1509.07012), shown beside ours in the figures,
 and the list of its claims with what this package checks of each.
 
 Only numbers printed in the text or its tables are here; values that exist only as points in

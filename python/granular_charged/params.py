@@ -1,6 +1,6 @@
 """Physical parameters, JKR scales and the paper's dimensionless groups.
 
-References: ``physics.md`` sections 1-2 of the project, i.e. Chen, Li, Liu & Makse, Soft Matter
+References: ``doc/theory.md`` sections 1-2 of the project, i.e. Chen, Li, Liu & Makse, Soft Matter
 2016 (arXiv:1509.07012; "the paper"), its Table 1, Eqs. 1-2 (JKR), 7-8 (U_eff, Ad*), and
 Marshall, J. Comput. Phys. 228 (2009) 1541. SI units throughout.
 """
@@ -11,7 +11,7 @@ from dataclasses import asdict, dataclass, field
 
 E0 = 1.602176634e-19        # elementary charge [C]
 EPS0 = 8.8541878128e-12     # vacuum permittivity [F/m]
-QQR2E_LAMMPS_SI = 8.9876e9  # LAMMPS's 'units si' Coulomb constant (physics.md sec. 4)
+QQR2E_LAMMPS_SI = 8.9876e9  # LAMMPS's 'units si' Coulomb constant (doc/theory.md, eq. (3.1))
 K_EFF_PAPER = 51.0          # the paper's K_eff = 20 N_tot (L/r_p)^-2 with N_tot = 2000, L = 28 r_p
 
 
@@ -68,12 +68,12 @@ class DepositionParams:
 
 
 def pair_modulus(E: float, nu: float) -> float:
-    """E* of two like spheres: 1/E* = 2 (1 - nu^2)/E (physics.md sec. 1)."""
+    """E* of two like spheres: 1/E* = 2 (1 - nu^2)/E (doc/theory.md, eq. (1.1))."""
     return E / (2.0 * (1.0 - nu * nu))
 
 
 def contact_time(rp: float, rho: float, E: float, nu: float, U0: float) -> float:
-    """Hertz collision time of two like spheres at relative speed U0 (physics.md sec. 1):
+    """Hertz collision time of two like spheres at relative speed U0 (doc/theory.md, eq. (1.10)):
     t_c = 2.87 (m*^2 / (R E*^2 v))^(1/5), R = r_p/2, m* = m/2."""
     m = 4.0 / 3.0 * math.pi * rp ** 3 * rho
     return 2.87 * ((0.5 * m) ** 2 / (0.5 * rp * pair_modulus(E, nu) ** 2 * U0)) ** 0.2
@@ -94,7 +94,7 @@ def jkr_scales(R: float, Estar: float, gamma: float) -> dict:
 
 def jkr_force_of_overlap(delta, R, Estar, gamma):
     """Elastic-adhesive normal force F_ne(delta) (> 0 repulsive) on the attached JKR branch,
-    from F/F_C = 4 (a^3 - a^1.5) and delta/delta_C = 6^(1/3) (2 a^2 - 4/3 a^0.5) (physics.md
+    from F/F_C = 4 (a^3 - a^1.5) and delta/delta_C = 6^(1/3) (2 a^2 - 4/3 a^0.5) (doc/theory.md, eq. (1.4)
     sec. 1; the squared form, not the paper's typo). Valid for -delta_C <= delta; vectorised."""
     import numpy as np
     s = jkr_scales(R, Estar, gamma)
@@ -127,7 +127,7 @@ def dimensionless(gamma, rho, U0, rp, q_e0, K_eff=K_EFF_PAPER) -> dict:
     U_eff^2 = U0^2 (1 - E*),  Ad* = gamma / (rho U_eff^2 r_p)  (Eqs. 7-8)
 
     Units check: q = 400 e_0, r_p = 2 um, U0 = 1 m/s, rho = 2500 gives E* = 0.59 < 1 and
-    E* = 1 at q ~ 520 e_0, as in physics.md sec. 2. Ad* is infinite (returned as inf) when
+    E* = 1 at q ~ 520 e_0, as doc/theory.md, eq. (2.2) implies. Ad* is infinite (returned as inf) when
     E* >= 1 (injected particles cannot reach the bed).
     """
     q = q_e0 * E0

@@ -24,7 +24,7 @@ from .runner import RunError, Runner
 log = logging.getLogger(__name__)
 
 # The paper's cases (its Figs. 2, 3a-c, 5a-c, 9, 10), N = 2000, L = 28 r_p, H = 160 r_p.
-# Charges stay below E* = 1 (physics.md sec. 2) for each (r_p, U_0).
+# Charges stay below E* = 1 (doc/theory.md, eq. (2.3)) for each (r_p, U_0).
 PAPER_SETS = tuple(MappingProxyType(s) for s in (
     dict(rp=2e-6, U0=1.0, gamma=0.010, q=[0, 100, 200, 260, 330, 400]),   # Figs. 2, 3c, 4, 5a, 7
     dict(rp=1e-6, U0=1.0, gamma=0.010, q=[0, 30, 60, 90, 120]),           # Figs. 3a, 5c

@@ -56,13 +56,11 @@ void GranSubModDampingMarshall::init()
 }
 
 /* ----------------------------------------------------------------------
-   F_nd = -eta_N (v_ij . n),  eta_N = alpha(e) sqrt(2 m* k_N),  k_N = 4/3 E* a
-   (Marshall 2009; the paper's eq. 2 and LAMMPS's tsuji print sqrt(m* k_N)).
-   The factor 2 under the root is what makes the Tsuji fit alpha(e) deliver e: the rebound of
-   the scale-free damped Hertz oscillator x'' = -x^(3/2) - c alpha(e) x^(1/4) x' equals e for
-   c = 1.414 (e = 0.3 ... 0.7) and 1.417 (e = 0.9), while the printed form (c = 1) gives
-   0.440 for e = 0.3 and 0.778 for e = 0.7 (measured here, for LAMMPS's hertz/material +
-   tsuji as well). See doc/pair_granular_jkr_marshall.md.
+   F_nd = -eta_N (v_ij . n),  eta_N = alpha(e) sqrt(mass_factor m* k_N),  k_N = 4/3 E* a
+   (doc/theory.md, eqs. (1.5)-(1.6)). mass_factor 2 (marshall) makes the Tsuji fit alpha(e)
+   deliver e for a Hertz collision; 1 (marshall/printed) is the form printed in the paper's
+   eq. 2 and in LAMMPS's tsuji, which rebounds with more than e (figures in
+   doc/pair_granular_jkr_marshall.md).
    a >= 0.30285 a_0 > 0 for every live JKR contact, so k_N > 0 also in tension.
 ------------------------------------------------------------------------- */
 

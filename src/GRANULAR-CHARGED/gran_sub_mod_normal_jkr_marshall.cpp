@@ -84,7 +84,7 @@ void GranSubModNormalJKRMarshall::coeffs_to_local()
 }
 
 /* ----------------------------------------------------------------------
-   unlike types: E* and G* from both materials (physics.md sec. 1), surface energy and
+   unlike types: E* and G* from both materials (doc/theory.md, eq. (1.1)), surface energy and
    restitution by geometric mean (work of adhesion 2 sqrt(gamma_i gamma_j), Berthelot-like)
 ------------------------------------------------------------------------- */
 
@@ -151,7 +151,7 @@ double GranSubModNormalJKRMarshall::pulloff_distance(double radi, double radj)
         = 4 E a^3 / (3 R) - 4 sqrt(pi gamma E a^3)
    with the contact radius a(delta) of the JKR relation on its stable branch
    (GranSubModNormalJKR::calculate_contact_radius, checked against the check points of
-   physics.md in the unit tests). F_adhesive = 4 F_C (a/a_0)^(3/2) is kept for rolling marshall.
+   doc/theory.md, eq. (1.4), in the unit tests). F_adhesive = 4 F_C (a/a_0)^(3/2) is kept for rolling marshall.
 ------------------------------------------------------------------------- */
 
 double GranSubModNormalJKRMarshall::calculate_forces()

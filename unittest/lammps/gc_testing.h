@@ -48,7 +48,7 @@ class Lmp {
   LAMMPS_NS::LAMMPS *lmp;
 };
 
-// ---- JKR closed forms (physics.md sec. 1), independent of LAMMPS's implementation ----------
+// ---- JKR closed forms (doc/theory.md, eqs. (1.2)-(1.4)), independent of LAMMPS's implementation ----------
 struct JKR {
   double R, E, gamma;    // effective radius, effective modulus E*, surface energy
   double FC() const { return 3.0 * M_PI * gamma * R; }

@@ -1,5 +1,5 @@
 /* GRANULAR-CHARGED: jkr/marshall and companions (pair_style granular, fix wall/gran),
-   tested against the closed forms of physics.md sec. 1 (JKR relations written again,
+   tested against the closed forms of doc/theory.md, eqs. (1.2)-(1.9) (JKR relations written again,
    independently, in gc_testing.h). Units si: r_p = 1 um, E = 2e8 Pa, nu = 0.33,
    gamma = 0.01 J/m^2, rho = 2500 kg/m^3 (the paper's Table 1). */
 #include "gc_testing.h"
@@ -70,7 +70,7 @@ TEST(JKRMarshall, QuasiStaticCheckPoints)
   const JKR jkr{RP / 2, ESTAR_PAIR, GAMMA};
   const double FC = jkr.FC(), dC = jkr.deltaC();
 
-  // the test-side closed forms themselves hit the table of physics.md
+  // the test-side closed forms themselves hit the check points of doc/theory.md, eq. (1.4)
   EXPECT_NEAR(JKR::delta_of_ahat(1.0), 1.21141, 5e-6);
   EXPECT_NEAR(JKR::delta_of_ahat(std::pow(2.0, -2.0 / 3.0)), -0.48075, 5e-6);
   EXPECT_NEAR(JKR::delta_of_ahat(std::pow(6.0, -2.0 / 3.0)), -1.0, 1e-12);
