@@ -464,7 +464,10 @@ void FixCoulFMM::compute_field(bool with_slope)
   // near cutoff, for the same pairs at both evaluations (a pair crossing the cutoff would
   // otherwise enter the slope as a jump): slope = (E(t_e) - E(t_p) - D) / (t_e - t_p) with D
   // the near-pair difference of the refresh, taken over t_p -> t_e.
-  const bool slope_ok = with_slope && last_computed >= 0 && step > last_computed &&
+  // Only over a full interval: two evaluations differ also by the solver's own error (which
+  // changes when the tree does), and that difference divided by a short interval would be
+  // extrapolated over a long one.
+  const bool slope_ok = with_slope && last_computed >= 0 && step - last_computed >= every &&
       atom->natoms == natoms_computed && stored_field_valid();
   if (slope_ok && near_cutoff > 0.0) near_pair_difference(near_now);
   for (int i = 0; i < nlocal; i++) {
