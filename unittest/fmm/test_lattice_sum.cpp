@@ -2,6 +2,7 @@
 // the exact far field (PeriodicFarField). References written here, independent of the
 // library: brute-force square-shell sums with their analytic tails, and a 2D Ewald sum with a
 // different splitting parameter and a plain (full-plane, libm cos/sin) reciprocal loop.
+#include "gcfmm/far_field.hpp"
 #include "gcfmm/lattice_sum.hpp"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,5 @@
-// Solver hooks into the 2D-periodic far field (FarField::Exact / Average), kept apart from
-// test_solver so that the near-field tests run whatever the state of the far-field code.
-// The far field's own accuracy is tested in test_lattice_sum / test_average_field.
+// Solver hooks into the 2D-periodic far field (FarField::Exact / Average). The far field's
+// own accuracy is tested in test_lattice_sum / test_average_field.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -30,7 +29,6 @@ Field periodic_run(const gcfmm_test::Particles &p, FarField ff, Stats *st = null
 }
 }  // namespace
 
-#if __has_include("gcfmm/lattice_sum.hpp")
 // The exact far field changes the near-field result, is finite, keeps the total force ~ 0
 // (a periodic layer exerts no net force on itself; FMM + far-field errors ~ accuracy), and
 // the work partitions still sum bit-identically.
@@ -54,9 +52,7 @@ TEST(SolverFarField, ExactHook) {
   for (std::size_t i = 0; i < p.size(); ++i) mism += (a.ez[i] + b.ez[i] != f.ez[i]) + (a.pot[i] + b.pot[i] != f.pot[i]);
   EXPECT_EQ(mism, 0u);
 }
-#endif
 
-#if __has_include("gcfmm/average_field.hpp")
 // The average far field adds a field along z only (uniform slab outside the block; its
 // in-plane parts cancel by symmetry up to the targets' offsets) and is finite.
 TEST(SolverFarField, AverageHook) {
@@ -70,9 +66,7 @@ TEST(SolverFarField, AverageHook) {
   }
   EXPECT_GT(dz, 0.0);
 }
-#endif
 
-#if __has_include("gcfmm/average_field.hpp")
 // A single charged particle (bed of zero height by the automatic bed range) must not fail.
 TEST(SolverFarField, AverageWithFlatBed) {
   auto p = gcfmm_test::deposition(300, 115);
@@ -80,4 +74,3 @@ TEST(SolverFarField, AverageWithFlatBed) {
   Field f = periodic_run(p, FarField::Average);
   for (std::size_t i = 0; i < p.size(); ++i) EXPECT_TRUE(std::isfinite(f.ez[i]));
 }
-#endif

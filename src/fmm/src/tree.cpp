@@ -1,4 +1,5 @@
-// GRANULAR-CHARGED FMM core library (gcfmm): adaptive octree.
+// GRANULAR-CHARGED FMM core library (gcfmm): adaptive octree (src/fmm/README.md, "Tree and
+// traversal").
 #include "gcfmm/tree.hpp"
 
 #include <algorithm>
@@ -33,7 +34,7 @@ void Tree::build(std::size_t n, const double *x, const double *y, const double *
     lo[2] = std::min(lo[2], zs[i]); hi[2] = std::max(hi[2], zs[i]);
   }
   Node root;
-  root.center = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
+  root.cube_center = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
   root.half = 0.5 * std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
   root.half = root.half * (1.0 + 1e-12) + 1e-300;
   root.begin = 0;
@@ -91,7 +92,8 @@ void Tree::split(std::int32_t ni, int leaf, std::vector<std::uint32_t> &scratch)
   // octant of every particle; xs/ys/zs are still in original order here
   std::uint32_t cnt[8] = {0, 0, 0, 0, 0, 0, 0, 0};
   auto octant = [&](std::uint32_t p) {
-    return (xs[p] >= nd.center.x ? 1 : 0) | (ys[p] >= nd.center.y ? 2 : 0) | (zs[p] >= nd.center.z ? 4 : 0);
+    return (xs[p] >= nd.cube_center.x ? 1 : 0) | (ys[p] >= nd.cube_center.y ? 2 : 0) |
+           (zs[p] >= nd.cube_center.z ? 4 : 0);
   };
   for (std::uint32_t k = nd.begin; k < nd.end; ++k) ++cnt[octant(perm[k])];
   std::uint32_t off[8];
@@ -102,7 +104,6 @@ void Tree::split(std::int32_t ni, int leaf, std::vector<std::uint32_t> &scratch)
     s += cnt[o];
     if (cnt[o]) ++nonempty;
   }
-  if (nonempty == 1 && nd.half < 1e-300) return;
   for (std::uint32_t k = nd.begin; k < nd.end; ++k) scratch[off[octant(perm[k])]++] = perm[k];
   std::copy(scratch.begin() + nd.begin, scratch.begin() + nd.end, perm.begin() + nd.begin);
 
@@ -113,8 +114,8 @@ void Tree::split(std::int32_t ni, int leaf, std::vector<std::uint32_t> &scratch)
     if (!cnt[o]) continue;
     Node c;
     c.half = h;
-    c.center = {nd.center.x + ((o & 1) ? h : -h), nd.center.y + ((o & 2) ? h : -h),
-                nd.center.z + ((o & 4) ? h : -h)};
+    c.cube_center = {nd.cube_center.x + ((o & 1) ? h : -h), nd.cube_center.y + ((o & 2) ? h : -h),
+                     nd.cube_center.z + ((o & 4) ? h : -h)};
     c.begin = b;
     c.end = b + cnt[o];
     b = c.end;

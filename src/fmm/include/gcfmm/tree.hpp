@@ -17,8 +17,9 @@ namespace gcfmm {
 //! One node (cube) of the octree.
 struct Node {
   Vec3 center;            //!< expansion centre: centre of the bounding box of its particles
+  Vec3 cube_center;       //!< centre of the geometric cube (the octants are split about it)
   double radius = 0.0;    //!< max distance of its particles from `center`
-  double half = 0.0;      //!< half side of the geometric cube
+  double half = 0.0;      //!< half side of the geometric cube (about cube_center)
   std::uint32_t begin = 0;  //!< first particle (sorted order)
   std::uint32_t end = 0;    //!< one past the last particle
   std::int32_t child = -1;  //!< index of the first child (children are contiguous), -1 for a leaf
