@@ -107,7 +107,7 @@ void fill_negative_m(int nmax, double *Xr, double *Xi) {
 // NF >= 0: the row n = NF is known at compile time, so the n+1 outputs of all lanes stay in
 // registers while (k, l) run over the sources; NF < 0: any row n <= kMaxOrder (high orders).
 template <int NF>
-void m2l_row(int n, int p, const double *__restrict Mr, const double *__restrict Mi, const double *__restrict Tr,
+inline void m2l_row(int n, int p, const double *__restrict Mr, const double *__restrict Mi, const double *__restrict Tr,
              const double *__restrict Ti, double *__restrict Ar, double *__restrict Ai) {
   constexpr int W = kLanes;
   constexpr int kRows = NF >= 0 ? NF + 1 : kMaxOrder + 1;
@@ -136,16 +136,23 @@ void m2l_row(int n, int p, const double *__restrict Mr, const double *__restrict
     }
 }
 
+// rows n > kMaxFixedRow (orders 17..kMaxOrder): the runtime row, kept out of line so that its
+// large accumulator arrays do not enlarge the stack frame of the compile-time rows
+__attribute__((noinline)) void m2l_rows_runtime(int p, const double *Mr, const double *Mi, const double *Tr,
+                                                const double *Ti, double *Ar, double *Ai) {
+  for (int n = kMaxFixedRow + 1; n <= p; ++n) m2l_row<-1>(n, p, Mr, Mi, Tr, Ti, Ar, Ai);
+}
+
 // all rows n = N..p: compile-time rows up to kMaxFixedRow, the runtime row beyond
 template <int N>
-void m2l_rows(int p, const double *Mr, const double *Mi, const double *Tr, const double *Ti, double *Ar, double *Ai) {
+inline void m2l_rows(int p, const double *Mr, const double *Mi, const double *Tr, const double *Ti, double *Ar,
+                     double *Ai) {
   if (N > p) return;
   m2l_row<N>(N, p, Mr, Mi, Tr, Ti, Ar, Ai);
-  if constexpr (N < kMaxFixedRow) {
+  if constexpr (N < kMaxFixedRow)
     m2l_rows<N + 1>(p, Mr, Mi, Tr, Ti, Ar, Ai);
-  } else {
-    for (int n = N + 1; n <= p; ++n) m2l_row<-1>(n, p, Mr, Mi, Tr, Ti, Ar, Ai);
-  }
+  else
+    m2l_rows_runtime(p, Mr, Mi, Tr, Ti, Ar, Ai);
 }
 
 // coordinates of the points [j0, j0 + kLanes) relative to c, and the number of lanes in use;

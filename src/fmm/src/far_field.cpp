@@ -38,7 +38,7 @@ constexpr ParamSet kParams[] = {
     {10, 8, 1.0, 2.6e-6},   // 1e-5
     {12, 10, 1.0, 7.8e-8},  // 1e-6
     {14, 12, 1.0, 4.3e-9},  // 1e-7
-    {14, 12, 0.7, 4.3e-9},  // 1e-8 (measured 7.1e-10 deposition, 4.2e-9 thin layer)
+    {14, 12, 0.7, 4.3e-9},  // 1e-8
 };
 
 int param_index(double accuracy) {
@@ -252,8 +252,8 @@ void PeriodicFarField::setup_explicit(double x0, double y0, double lx, double ly
           }
     }
 
-  // sampled kernel error, scaled by 20: the largest ratio of measured far-field error to
-  // this sample seen in the calibration scan was ~35 (thin layer), typical 5-15
+  // sampled kernel error, scaled by 20 (the ratio of the far-field error to this sample in the
+  // calibration scan: doc/fmm-far-field.md)
   est_error_ = 20.0 * sample_error();
   accuracy_ = 0.0;
   setup_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();

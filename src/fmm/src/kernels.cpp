@@ -46,7 +46,7 @@ inline void p2p_generic(std::size_t nt, const double *__restrict xt, const doubl
 // operations wherever it sits, so a target's result depends only on its position and the
 // source range. 1/sqrt(r2) comes from the 14-bit hardware estimate (vrsqrt14pd) refined by
 // two Newton steps y <- y (3 - r2 y^2) / 2 (relative error 2^-14 -> 2^-28 -> ~1e-16),
-// because vsqrtpd + vdivpd are about 10x slower on the machine measured (doc/fmm-accuracy.md).
+// because vsqrtpd + vdivpd are much slower (doc/benchmarks.md, "P2P kernels").
 inline void p2p_avx512(std::size_t nt, const double *__restrict xt, const double *__restrict yt,
                        const double *__restrict zt, std::size_t ns, const double *__restrict xs,
                        const double *__restrict ys, const double *__restrict zs, const double *__restrict qs,

@@ -303,7 +303,8 @@ void Solver::Impl::downward(const TargetRange &t) {
   });
 }
 
-// The image cells beyond the near block: exact (eq. (4.6)) or the paper's average (eq. (4.7)).
+// The image cells beyond the near block (doc/theory.md, eq. (4.1)): exact (eq. (4.6)) or the
+// average field (eq. (4.7)).
 void Solver::Impl::far_field(const TargetRange &t) {
   if (!periodic()) return;
   const auto &xs = tree.xs, &ys = tree.ys, &zs = tree.zs;
