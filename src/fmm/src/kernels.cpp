@@ -17,7 +17,7 @@ inline void p2p_generic(std::size_t nt, const double *__restrict xt, const doubl
                         const double *__restrict zt, std::size_t ns, const double *__restrict xs,
                         const double *__restrict ys, const double *__restrict zs, const double *__restrict qs,
                         double sx, double sy, double sz, double *__restrict pot, double *__restrict ex,
-                        double *__restrict ey, double *__restrict ez) {
+                        double *__restrict ey, double *__restrict ez, double r2_min) {
   for (std::size_t i = 0; i < nt; ++i) {
     const double xi = xt[i] - sx, yi = yt[i] - sy, zi = zt[i] - sz;
     double p = 0.0, fx = 0.0, fy = 0.0, fz = 0.0;
@@ -25,7 +25,7 @@ inline void p2p_generic(std::size_t nt, const double *__restrict xt, const doubl
     for (std::size_t j = 0; j < ns; ++j) {
       const double dx = xi - xs[j], dy = yi - ys[j], dz = zi - zs[j];
       const double r2 = dx * dx + dy * dy + dz * dz;
-      const double inv = r2 > 0.0 ? 1.0 / std::sqrt(r2) : 0.0;
+      const double inv = r2 > r2_min ? 1.0 / std::sqrt(r2) : 0.0;
       const double qinv = qs[j] * inv;
       const double qinv3 = qinv * inv * inv;
       p += qinv;
@@ -51,7 +51,8 @@ inline void p2p_avx512(std::size_t nt, const double *__restrict xt, const double
                        const double *__restrict zt, std::size_t ns, const double *__restrict xs,
                        const double *__restrict ys, const double *__restrict zs, const double *__restrict qs,
                        double sx, double sy, double sz, double *__restrict pot, double *__restrict ex,
-                       double *__restrict ey, double *__restrict ez) {
+                       double *__restrict ey, double *__restrict ez, double r2_min) {
+  const __m512d rmin2 = _mm512_set1_pd(r2_min);
   const __m512d half = _mm512_set1_pd(0.5), three_half = _mm512_set1_pd(1.5), zero = _mm512_setzero_pd();
   for (std::size_t i = 0; i < nt; i += 8) {
     const std::size_t left = nt - i;
@@ -66,7 +67,7 @@ inline void p2p_avx512(std::size_t nt, const double *__restrict xt, const double
       const __m512d dz = _mm512_sub_pd(zi, _mm512_set1_pd(zs[j]));
       const __m512d q = _mm512_set1_pd(qs[j]);
       const __m512d r2 = _mm512_fmadd_pd(dx, dx, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dz, dz)));
-      const __mmask8 nz = _mm512_cmp_pd_mask(r2, zero, _CMP_GT_OQ);  // drop r = 0 (self term)
+      const __mmask8 nz = _mm512_cmp_pd_mask(r2, rmin2, _CMP_GT_OQ);  // drop the self term and coincident pairs
       __m512d y = _mm512_maskz_rsqrt14_pd(nz, r2);
       const __m512d hr2 = _mm512_mul_pd(half, r2);
       y = _mm512_mul_pd(y, _mm512_fnmadd_pd(hr2, _mm512_mul_pd(y, y), three_half));
@@ -90,11 +91,11 @@ inline void p2p_avx512(std::size_t nt, const double *__restrict xt, const double
 
 void p2p(std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns, const double *xs,
          const double *ys, const double *zs, const double *qs, double sx, double sy, double sz, double *pot,
-         double *ex, double *ey, double *ez) {
+         double *ex, double *ey, double *ez, double r2_min) {
 #if defined(__AVX512F__)
-  p2p_avx512(nt, xt, yt, zt, ns, xs, ys, zs, qs, sx, sy, sz, pot, ex, ey, ez);
+  p2p_avx512(nt, xt, yt, zt, ns, xs, ys, zs, qs, sx, sy, sz, pot, ex, ey, ez, r2_min);
 #else
-  p2p_generic(nt, xt, yt, zt, ns, xs, ys, zs, qs, sx, sy, sz, pot, ex, ey, ez);
+  p2p_generic(nt, xt, yt, zt, ns, xs, ys, zs, qs, sx, sy, sz, pot, ex, ey, ez, r2_min);
 #endif
 }
 

@@ -50,6 +50,16 @@ double wrap(double v, double lo, double l) {
   return w;
 }
 
+// The solver's length unit: the power of two >= extent (1 if the extent is zero or not
+// finite). Scaling by a power of two is exact, so the arithmetic in scaled coordinates gives
+// bit-identical results, and r^n, r^-(n+1) of the expansions stay in range at any box size.
+double length_unit(double extent) {
+  if (!(extent > 0.0) || !std::isfinite(extent)) return 1.0;
+  int e = 0;
+  std::frexp(extent, &e);  // extent = m 2^e, m in [0.5, 1)
+  return std::ldexp(1.0, e);
+}
+
 //! The targets of one work partition: sorted particle indices [begin, end).
 struct TargetRange {
   std::size_t begin = 0, end = 0;
@@ -71,7 +81,9 @@ struct Solver::Impl {
   Tree tree;
   InteractionLists lists;
   std::unique_ptr<Operators> ops;
-  std::vector<double> wrapped_x, wrapped_y;   // wrapped input positions (original order)
+  double h = 1.0, inv_h = 1.0;                // length unit (power of two) and its inverse
+  double sx0 = 0.0, sy0 = 0.0, slx = 0.0, sly = 0.0;  // the cell in units of h
+  std::vector<double> scaled_x, scaled_y, scaled_z;   // wrapped positions / h (original order)
   std::vector<double> multipole, local;       // expansions, ops->size() doubles per node
   std::vector<char> has_local;                // node has a nonzero local expansion
   // charges and results in the tree's (sorted) particle order
@@ -79,8 +91,8 @@ struct Solver::Impl {
   std::vector<const double *> batch_m;        // M2L batch of one target node: source multipoles
   std::vector<Vec3> batch_r;                  // and translation vectors
   std::vector<double> leaf_prefix;            // cumulative estimated cost over leaves
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> coincident;  // sorted indices
-  double zmin = 0.0, zmax = 0.0;              // z range of all particles
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> coincident;  // sorted indices, closer than kCoincidenceRadius h
+  double zmin = 0.0, zmax = 0.0;              // z range of all particles (units of h)
   PeriodicFarField far;
 
   bool periodic() const { return opts.boundary == Boundary::Periodic2D; }
@@ -126,20 +138,35 @@ struct Solver::Impl {
   void far_field(const TargetRange &t);
 };
 
-// Positions of a periodic system are wrapped into the primary cell first.
+// Positions of a periodic system are wrapped into the primary cell first; all positions are
+// then expressed in the length unit h (the cell's for Periodic2D, the particles' extent in
+// free space), so the tree, the lists and the expansions see coordinates of order 1.
 void Solver::Impl::build_tree(const double *x, const double *y, const double *z) {
-  const double *px = x, *py = y;
   if (periodic()) {
-    wrapped_x.resize(n);
-    wrapped_y.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      wrapped_x[i] = wrap(x[i], x0, lx);
-      wrapped_y[i] = wrap(y[i], y0, ly);
-    }
-    px = wrapped_x.data();
-    py = wrapped_y.data();
+    h = length_unit(std::max(lx, ly));
+  } else {
+    double extent = 0.0;
+    if (n > 0)
+      for (const double *c : {x, y, z}) {
+        const auto [lo, hi] = std::minmax_element(c, c + n);
+        extent = std::max(extent, *hi - *lo);
+      }
+    h = length_unit(extent);
   }
-  tree.build(n, px, py, z, res.leaf);
+  inv_h = 1.0 / h;
+  sx0 = x0 * inv_h;
+  sy0 = y0 * inv_h;
+  slx = lx * inv_h;
+  sly = ly * inv_h;
+  scaled_x.resize(n);
+  scaled_y.resize(n);
+  scaled_z.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    scaled_x[i] = (periodic() ? wrap(x[i], x0, lx) : x[i]) * inv_h;
+    scaled_y[i] = (periodic() ? wrap(y[i], y0, ly) : y[i]) * inv_h;
+    scaled_z[i] = z[i] * inv_h;
+  }
+  tree.build(n, scaled_x.data(), scaled_y.data(), scaled_z.data(), res.leaf);
   zmin = zmax = 0.0;
   if (n > 0) {
     const auto [lo, hi] = std::minmax_element(tree.zs.begin(), tree.zs.end());
@@ -154,7 +181,7 @@ void Solver::Impl::build_interaction_lists() {
   if (periodic()) {
     const int k = opts.images;
     for (int nx = -k; nx <= k; ++nx)
-      for (int ny = -k; ny <= k; ++ny) shifts.push_back({nx * lx, ny * ly, 0.0});
+      for (int ny = -k; ny <= k; ++ny) shifts.push_back({nx * slx, ny * sly, 0.0});
   } else {
     shifts.push_back({0.0, 0.0, 0.0});
   }
@@ -199,24 +226,44 @@ void Solver::Impl::estimate_partition_costs() {
   }
 }
 
-// Coincident particles always share a leaf.
+// Pairs closer than the coincidence radius (kCoincidenceRadius h, solver.hpp), periodic
+// images included. Such a pair lies in one leaf or in a P2P list entry (an M2L pair of
+// nodes at that distance would need both nodes smaller than the radius and holding more
+// particles than the P2P threshold (3.16), i.e. coincident pairs inside them as well), so
+// the P2P entries whose bounding boxes come that close are searched pair by pair.
 void Solver::Impl::find_coincident_pairs() {
   coincident.clear();
   const auto &xs = tree.xs, &ys = tree.ys, &zs = tree.zs;
-  for (auto li : tree.leaves) {
-    const Node &A = tree.nodes[li];
-    for (std::uint32_t a = A.begin; a < A.end; ++a)
-      for (std::uint32_t b = a + 1; b < A.end; ++b)
-        if (xs[a] == xs[b] && ys[a] == ys[b] && zs[a] == zs[b]) coincident.emplace_back(a, b);
+  const double r2 = kCoincidenceRadius * kCoincidenceRadius;
+  auto gap = [](double alo, double ahi, double blo, double bhi) {
+    return std::max({alo - bhi, blo - ahi, 0.0});
+  };
+  for (const Interaction &e : lists.p2p) {
+    const Bounds &A = tree.bounds[e.target], &B = tree.bounds[e.source];
+    const Vec3 &s = lists.shifts[e.shift];
+    const double gx = gap(A.lo.x, A.hi.x, B.lo.x + s.x, B.hi.x + s.x);
+    const double gy = gap(A.lo.y, A.hi.y, B.lo.y + s.y, B.hi.y + s.y);
+    const double gz = gap(A.lo.z, A.hi.z, B.lo.z + s.z, B.hi.z + s.z);
+    if (gx * gx + gy * gy + gz * gz > r2) continue;
+    const Node &NA = tree.nodes[e.target], &NB = tree.nodes[e.source];
+    const bool same = e.target == e.source && s.x == 0.0 && s.y == 0.0;
+    for (std::uint32_t a = NA.begin; a < NA.end; ++a)
+      for (std::uint32_t b = same ? a + 1 : NB.begin; b < NB.end; ++b) {
+        const double dx = xs[a] - xs[b] - s.x, dy = ys[a] - ys[b] - s.y, dz = zs[a] - zs[b];
+        if (dx * dx + dy * dy + dz * dz <= r2) coincident.emplace_back(std::min(a, b), std::max(a, b));
+      }
   }
+  // each pair once (a pair in two entries, A-B and B-A, is found twice)
+  std::sort(coincident.begin(), coincident.end());
+  coincident.erase(std::unique(coincident.begin(), coincident.end()), coincident.end());
 }
 
 void Solver::Impl::setup_far_field() {
   if (!periodic() || opts.farfield != FarField::Exact) return;
   // the lattice sum accepts accuracies down to 1e-8 (its far field is smooth and tiny anyway)
   const double facc = std::max(opts.accuracy, 1e-8);
-  if (far.needs_setup(x0, y0, lx, ly, zmin, zmax, opts.images, facc))
-    far.setup(x0, y0, lx, ly, zmin, zmax, opts.images, facc);
+  if (far.needs_setup(sx0, sy0, slx, sly, zmin, zmax, opts.images, facc))
+    far.setup(sx0, sy0, slx, sly, zmin, zmax, opts.images, facc);
   stats.estimated_error += far.estimated_error();
 }
 
@@ -224,9 +271,12 @@ void Solver::Impl::sort_charges(const double *q) {
   const auto &perm = tree.perm;
   for (std::size_t k = 0; k < n; ++k) sorted_q[k] = q[perm[k]];
   for (const auto &c : coincident)
-    if (sorted_q[c.first] != 0.0 || sorted_q[c.second] != 0.0)
-      throw std::runtime_error("gcfmm: particles " + std::to_string(perm[c.first]) + " and " +
-                               std::to_string(perm[c.second]) + " are at the same position");
+    if (sorted_q[c.first] != 0.0 || sorted_q[c.second] != 0.0) {
+      const std::size_t i = std::min(perm[c.first], perm[c.second]), j = std::max(perm[c.first], perm[c.second]);
+      throw CoincidentParticles(i, j, "gcfmm: particles " + std::to_string(i) + " and " + std::to_string(j) +
+                                          " are at the same position (closer than " +
+                                          std::to_string(kCoincidenceRadius * h) + ")");
+    }
 }
 
 // Upward pass: P2M at leaves (eq. (3.9)), M2M to parents (eq. (3.10)); children have larger
@@ -278,7 +328,8 @@ void Solver::Impl::p2p(const TargetRange &t) {
       const Vec3 &sh = lists.shifts[it.shift];
       gcfmm::p2p(b - a, xs.data() + a, ys.data() + a, zs.data() + a, B.count(), xs.data() + B.begin,
                  ys.data() + B.begin, zs.data() + B.begin, sorted_q.data() + B.begin, sh.x, sh.y, sh.z,
-                 sorted_pot.data() + a, sorted_ex.data() + a, sorted_ey.data() + a, sorted_ez.data() + a);
+                 sorted_pot.data() + a, sorted_ex.data() + a, sorted_ey.data() + a, sorted_ez.data() + a,
+                 kCoincidenceRadius * kCoincidenceRadius);
     }
   });
 }
@@ -312,7 +363,7 @@ void Solver::Impl::far_field(const TargetRange &t) {
     far.evaluate(n, xs.data(), ys.data(), zs.data(), sorted_q.data(), t.begin, t.end, sorted_pot.data(),
                  sorted_ex.data(), sorted_ey.data(), sorted_ez.data());
   } else if (opts.farfield == FarField::Average) {
-    double blo = opts.bed_zlo, bhi = opts.bed_zhi;
+    double blo = opts.bed_zlo * inv_h, bhi = opts.bed_zhi * inv_h;
     if (std::isnan(blo)) {
       bool any = false;
       for (std::size_t k = 0; k < n; ++k)
@@ -323,14 +374,14 @@ void Solver::Impl::far_field(const TargetRange &t) {
         }
       if (!any) return;
     }
-    if (!(bhi - blo > 1e-6 * std::min(lx, ly))) {
+    if (!(bhi - blo > 1e-6 * std::min(slx, sly))) {
       // a flat layer of charges (e.g. one charged particle): the slab becomes a sheet; give it
       // a small thickness (relative change of the far field ~ 1e-6)
-      const double mid = 0.5 * (blo + bhi), h = 0.5e-6 * std::min(lx, ly);
-      blo = mid - h;
-      bhi = mid + h;
+      const double mid = 0.5 * (blo + bhi), half = 0.5e-6 * std::min(slx, sly);
+      blo = mid - half;
+      bhi = mid + half;
     }
-    average_far_field(n, xs.data(), ys.data(), zs.data(), sorted_q.data(), x0, y0, lx, ly, opts.images, blo, bhi,
+    average_far_field(n, xs.data(), ys.data(), zs.data(), sorted_q.data(), sx0, sy0, slx, sly, opts.images, blo, bhi,
                       t.begin, t.end, sorted_pot.data(), sorted_ex.data(), sorted_ey.data(), sorted_ez.data());
   }
 }
@@ -426,14 +477,15 @@ void Solver::evaluate(const double *q, double *pot, double *ex, double *ey, doub
   s.t_downward = timed([&] { I.downward(t); });
   s.t_far = timed([&] { I.far_field(t); });
 
-  // scatter to the caller's order
+  // scatter to the caller's order, back from the length unit h: pot ~ 1/length, E ~ 1/length^2
   const auto &perm = I.tree.perm;
+  const double fp = I.inv_h, fe = I.inv_h * I.inv_h;
   for (std::size_t k = t.begin; k < t.end; ++k) {
     const std::size_t i = perm[k];
-    pot[i] = I.sorted_pot[k];
-    ex[i] = I.sorted_ex[k];
-    ey[i] = I.sorted_ey[k];
-    ez[i] = I.sorted_ez[k];
+    pot[i] = fp * I.sorted_pot[k];
+    ex[i] = fe * I.sorted_ex[k];
+    ey[i] = fe * I.sorted_ey[k];
+    ez[i] = fe * I.sorted_ez[k];
   }
 }
 
