@@ -89,6 +89,18 @@ class Solver {
    *  or meaningless); std::runtime_error if build() was not called. */
   void evaluate(const double *q, double *pot, double *ex, double *ey, double *ez, int part = 0, int nparts = 1);
 
+  /** @brief Per-particle potential u of the energy of the last evaluate(): the energy
+   *  U = 1/2 sum_i q_i u_i is the one whose gradient is minus the applied forces q_i E_i
+   *  (doc/theory.md, eq. (4.10)). u = pot, except with FarField::Average: the smeared far
+   *  images do not move with the particles (an external field for them), so the energy
+   *  whose gradient is the applied force is sum_i q_i phi_far(r_i), without the 1/2 of a
+   *  field the particles make themselves, and u holds the average far part twice. Exact
+   *  when the bed is given (Options::bed_zlo/bed_zhi); with the automatic bed the two
+   *  particles that bound it also move the bed. Written for the targets of the last
+   *  evaluate()'s part, 0 elsewhere (so the parts sum like pot).
+   *  @throws std::runtime_error if evaluate() was not called since the last build(). */
+  void energy_potential(double *u) const;
+
   /** @brief Parameters and timings of the last build()/evaluate(). */
   const Stats &stats() const;
 
