@@ -8,6 +8,7 @@
 #include "gcfmm/expansions.hpp"
 
 #include "gcfmm/options.hpp"
+#include "simd_paths.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -15,6 +16,17 @@
 #include <string>
 
 namespace gcfmm {
+
+namespace detail {
+// The state the batched operators work on: order, recurrence tables and lane scratch.
+struct LaneState {
+  int p, S;               // order and (p+1)^2
+  const double *inv_nm;   // regular recurrence table
+  const double *nm1;      // irregular recurrence table
+  double *harm, *mult, *acc;  // lane scratch: harmonics, gathered multipoles, accumulators
+};
+
+}  // namespace detail
 
 namespace {
 
@@ -35,7 +47,7 @@ enum class Kind { Regular, Irregular };
 //   T_n^m = ((2n-1) z T_{n-1}^m - (n-1+m)(n-1-m) T_{n-2}^m) / r^2.
 // `tab` is inv_nm (regular) or nm1 (irregular), indexed [n * (p + 1) + m].
 template <Kind K, int W>
-void solid_harmonics(int nmax, int p, const double *tab, const double *x, const double *y, const double *z,
+GCFMM_ALWAYS_INLINE void solid_harmonics(int nmax, int p, const double *tab, const double *x, const double *y, const double *z,
                      double *__restrict Xr, double *__restrict Xi) {
   double r2[W], ir2[W];
   for (int v = 0; v < W; ++v) {
@@ -89,7 +101,7 @@ void solid_harmonics(int nmax, int p, const double *tab, const double *x, const 
 
 // m < 0 from X_n^{-m} = (-1)^m conj(X_n^m) (doc/theory.md, eq. (3.4)), lane-major, n <= nmax
 template <int W>
-void fill_negative_m(int nmax, double *Xr, double *Xi) {
+GCFMM_ALWAYS_INLINE void fill_negative_m(int nmax, double *Xr, double *Xi) {
   for (int n = 1; n <= nmax; ++n)
     for (int m = 1; m <= n; ++m) {
       const double s = (m & 1) ? -1.0 : 1.0;
@@ -107,7 +119,7 @@ void fill_negative_m(int nmax, double *Xr, double *Xi) {
 // NF >= 0: the row n = NF is known at compile time, so the n+1 outputs of all lanes stay in
 // registers while (k, l) run over the sources; NF < 0: any row n <= kMaxOrder (high orders).
 template <int NF>
-inline void m2l_row(int n, int p, const double *__restrict Mr, const double *__restrict Mi, const double *__restrict Tr,
+GCFMM_ALWAYS_INLINE void m2l_row(int n, int p, const double *__restrict Mr, const double *__restrict Mi, const double *__restrict Tr,
              const double *__restrict Ti, double *__restrict Ar, double *__restrict Ai) {
   constexpr int W = kLanes;
   constexpr int kRows = NF >= 0 ? NF + 1 : kMaxOrder + 1;
@@ -136,28 +148,21 @@ inline void m2l_row(int n, int p, const double *__restrict Mr, const double *__r
     }
 }
 
-// rows n > kMaxFixedRow (orders 17..kMaxOrder): the runtime row, kept out of line so that its
-// large accumulator arrays do not enlarge the stack frame of the compile-time rows
-__attribute__((noinline)) void m2l_rows_runtime(int p, const double *Mr, const double *Mi, const double *Tr,
-                                                const double *Ti, double *Ar, double *Ai) {
-  for (int n = kMaxFixedRow + 1; n <= p; ++n) m2l_row<-1>(n, p, Mr, Mi, Tr, Ti, Ar, Ai);
-}
-
 // all rows n = N..p: compile-time rows up to kMaxFixedRow, the runtime row beyond
 template <int N>
-inline void m2l_rows(int p, const double *Mr, const double *Mi, const double *Tr, const double *Ti, double *Ar,
+GCFMM_ALWAYS_INLINE void m2l_rows(int p, const double *Mr, const double *Mi, const double *Tr, const double *Ti, double *Ar,
                      double *Ai) {
   if (N > p) return;
   m2l_row<N>(N, p, Mr, Mi, Tr, Ti, Ar, Ai);
   if constexpr (N < kMaxFixedRow)
     m2l_rows<N + 1>(p, Mr, Mi, Tr, Ti, Ar, Ai);
   else
-    m2l_rows_runtime(p, Mr, Mi, Tr, Ti, Ar, Ai);
+    for (int n = N + 1; n <= p; ++n) m2l_row<-1>(n, p, Mr, Mi, Tr, Ti, Ar, Ai);
 }
 
 // coordinates of the points [j0, j0 + kLanes) relative to c, and the number of lanes in use;
 // lanes past np get the point 0 (harmless for regular harmonics)
-inline int gather_lanes(std::size_t j0, std::size_t np, const double *x, const double *y, const double *z,
+GCFMM_ALWAYS_INLINE int gather_lanes(std::size_t j0, std::size_t np, const double *x, const double *y, const double *z,
                         const Vec3 &c, double *dx, double *dy, double *dz) {
   const int nl = static_cast<int>(std::min<std::size_t>(kLanes, np - j0));
   for (int v = 0; v < kLanes; ++v) {
@@ -169,59 +174,20 @@ inline int gather_lanes(std::size_t j0, std::size_t np, const double *x, const d
   return nl;
 }
 
-}  // namespace
+using detail::LaneState;
 
-Operators::Operators(int order) : p_(order), S_((order + 1) * (order + 1)) {
-  if (order < 1) throw std::invalid_argument("gcfmm: expansion order must be >= 1");
-  if (order > kMaxOrder)
-    throw std::invalid_argument("gcfmm: expansion order must be <= " + std::to_string(kMaxOrder));
-  inv_nm_.assign(static_cast<std::size_t>((p_ + 1) * (p_ + 1)), 0.0);
-  nm1_.assign(static_cast<std::size_t>((p_ + 1) * (p_ + 1)), 0.0);
-  for (int n = 0; n <= p_; ++n)
-    for (int m = 0; m <= n; ++m) {
-      if (m < n) inv_nm_[n * (p_ + 1) + m] = 1.0 / (double(n + m) * double(n - m));
-      nm1_[n * (p_ + 1) + m] = double(n - 1 + m) * double(n - 1 - m);
-    }
-  harm_re_.assign(S_, 0.0);
-  harm_im_.assign(S_, 0.0);
-  lane_harm_.assign(2 * static_cast<std::size_t>(S_) * kBatch, 0.0);
-  lane_mult_.assign(2 * static_cast<std::size_t>(S_) * kBatch, 0.0);
-  lane_acc_.assign(2 * static_cast<std::size_t>(S_) * kBatch, 0.0);
-}
-
-void Operators::regular(const Vec3 &r, int nmax, double *re, double *im) const {
-  solid_harmonics<Kind::Regular, 1>(nmax, p_, inv_nm_.data(), &r.x, &r.y, &r.z, re, im);
-  fill_negative_m<1>(nmax, re, im);
-}
-
-void Operators::irregular(const Vec3 &r, int nmax, double *re, double *im) const {
-  solid_harmonics<Kind::Irregular, 1>(nmax, p_, nm1_.data(), &r.x, &r.y, &r.z, re, im);
-  fill_negative_m<1>(nmax, re, im);
-}
-
-void Operators::symmetrize(double *a) const {
-  double *re = a, *im = a + S_;
-  for (int n = 0; n <= p_; ++n) im[idx(n, 0)] = 0.0;  // exact for real charges; removes round-off
-  fill_negative_m<1>(p_, re, im);
-}
-
-void Operators::p2m(std::size_t np, const double *x, const double *y, const double *z, const double *q,
-                    const Vec3 &c, double *M) {
-  p2m_batch(np, x, y, z, q, c, M);
-}
-
-void Operators::p2m_batch(std::size_t np, const double *x, const double *y, const double *z, const double *q,
+GCFMM_ALWAYS_INLINE void p2m_batch_body(const LaneState &st, std::size_t np, const double *x, const double *y, const double *z, const double *q,
                           const Vec3 &c, double *M) {
-  constexpr int W = kBatch;
-  const int p = p_, S = S_;
-  double *Yr = lane_harm_.data(), *Yi = lane_harm_.data() + S * W;
-  double *__restrict Ar = lane_acc_.data(), *__restrict Ai = lane_acc_.data() + S * W;
-  std::fill(lane_acc_.begin(), lane_acc_.end(), 0.0);
+  constexpr int W = kLanes;
+  const int p = st.p, S = st.S;
+  double *Yr = st.harm, *Yi = st.harm + S * W;
+  double *__restrict Ar = st.acc, *__restrict Ai = st.acc + S * W;
+  std::fill(st.acc, st.acc + 2 * S * kLanes, 0.0);
   for (std::size_t j0 = 0; j0 < np; j0 += W) {
     double dx[W], dy[W], dz[W], qq[W];
     const int nl = gather_lanes(j0, np, x, y, z, c, dx, dy, dz);
     for (int v = 0; v < W; ++v) qq[v] = v < nl ? q[j0 + v] : 0.0;
-    solid_harmonics<Kind::Regular, W>(p, p, inv_nm_.data(), dx, dy, dz, Yr, Yi);
+    solid_harmonics<Kind::Regular, W>(p, p, st.inv_nm, dx, dy, dz, Yr, Yi);
     // eq. (3.9): M_n^m += q conj(Y_n^m)
     for (int n = 0; n <= p; ++n)
       for (int m = 0; m <= n; ++m) {
@@ -245,20 +211,16 @@ void Operators::p2m_batch(std::size_t np, const double *x, const double *y, cons
     }
 }
 
-void Operators::l2p(const double *L, const Vec3 &r, double &pot, double &ex, double &ey, double &ez) {
-  l2p_batch(L, Vec3{}, 1, &r.x, &r.y, &r.z, &pot, &ex, &ey, &ez);
-}
-
-void Operators::l2p_batch(const double *L, const Vec3 &c, std::size_t np, const double *x, const double *y,
+GCFMM_ALWAYS_INLINE void l2p_batch_body(const LaneState &st, const double *L, const Vec3 &c, std::size_t np, const double *x, const double *y,
                           const double *z, double *pot, double *ex, double *ey, double *ez) {
-  constexpr int W = kBatch;
-  const int p = p_, S = S_;
-  double *Yr = lane_harm_.data(), *Yi = lane_harm_.data() + S * W;
+  constexpr int W = kLanes;
+  const int p = st.p, S = st.S;
+  double *Yr = st.harm, *Yi = st.harm + S * W;
   const double *lr = L, *li = L + S;
   for (std::size_t j0 = 0; j0 < np; j0 += W) {
     double dx[W], dy[W], dz[W];
     const int nl = gather_lanes(j0, np, x, y, z, c, dx, dy, dz);
-    solid_harmonics<Kind::Regular, W>(p, p, inv_nm_.data(), dx, dy, dz, Yr, Yi);
+    solid_harmonics<Kind::Regular, W>(p, p, st.inv_nm, dx, dy, dz, Yr, Yi);
     double ph[W], a0[W], a1r[W], a1i[W];
     for (int v = 0; v < W; ++v) ph[v] = a0[v] = a1r[v] = a1i[v] = 0.0;
     // eq. (3.13): phi = sum_{n,m} L_n^m conj(Y_n^m) = sum_n [L_n^0 Y_n^0 + 2 sum_{m>0} Re(L_n^m conj(Y_n^m))]
@@ -298,6 +260,129 @@ void Operators::l2p_batch(const double *L, const Vec3 &c, std::size_t np, const 
   }
 }
 
+GCFMM_ALWAYS_INLINE void m2l_batch_body(const LaneState &st, std::size_t count, const double *const *Ms, const Vec3 *R, double *Lt) {
+  constexpr int W = kLanes;
+  const int p = st.p, S = st.S;
+  double *__restrict Tr = st.harm, *__restrict Ti = st.harm + S * W;
+  double *__restrict Mr = st.mult, *__restrict Mi = st.mult + S * W;
+  double *__restrict Ar = st.acc, *__restrict Ai = st.acc + S * W;
+  std::fill(st.acc, st.acc + 2 * S * kLanes, 0.0);
+  for (std::size_t e0 = 0; e0 < count; e0 += W) {
+    const int nl = static_cast<int>(std::min<std::size_t>(W, count - e0));
+    // gather the multipoles (lane v = entry e0 + v; empty lanes get M = 0 and R = e_x)
+    double x[W], y[W], z[W];
+    for (int v = 0; v < W; ++v) {
+      if (v < nl) {
+        const double *m = Ms[e0 + v];
+        for (int i = 0; i < S; ++i) {
+          Mr[i * W + v] = m[i];
+          Mi[i * W + v] = m[S + i];
+        }
+        x[v] = R[e0 + v].x;
+        y[v] = R[e0 + v].y;
+        z[v] = R[e0 + v].z;
+      } else {
+        for (int i = 0; i < S; ++i) Mr[i * W + v] = Mi[i * W + v] = 0.0;
+        x[v] = 1.0;
+        y[v] = z[v] = 0.0;
+      }
+    }
+    solid_harmonics<Kind::Irregular, W>(p, p, st.nm1, x, y, z, Tr, Ti);
+    fill_negative_m<W>(p, Tr, Ti);
+    m2l_rows<0>(p, Mr, Mi, Tr, Ti, Ar, Ai);
+  }
+  // lane sums in a fixed order, and the sign (-1)^n of eq. (3.11)
+  double *lr = Lt, *li = Lt + S;
+  for (int n = 0; n <= p; ++n) {
+    const double sgn = (n & 1) ? -1.0 : 1.0;
+    for (int m = 0; m <= n; ++m) {
+      double sr = 0.0, si = 0.0;
+      for (int v = 0; v < W; ++v) {
+        sr += Ar[idx(n, m) * W + v];
+        si += Ai[idx(n, m) * W + v];
+      }
+      lr[idx(n, m)] += sgn * sr;
+      li[idx(n, m)] += sgn * si;
+    }
+  }
+}
+
+// each batched operator compiled for every instruction-set path (src/simd_paths.hpp)
+GCFMM_DEFINE_SIMD_PATHS(void, p2m_batch_path,
+                        (const LaneState &st, std::size_t np, const double *x, const double *y, const double *z,
+                         const double *q, const Vec3 &c, double *M),
+                        p2m_batch_body, (st, np, x, y, z, q, c, M))
+GCFMM_DEFINE_SIMD_PATHS(void, l2p_batch_path,
+                        (const LaneState &st, const double *L, const Vec3 &c, std::size_t np, const double *x,
+                         const double *y, const double *z, double *pot, double *ex, double *ey, double *ez),
+                        l2p_batch_body, (st, L, c, np, x, y, z, pot, ex, ey, ez))
+GCFMM_DEFINE_SIMD_PATHS(void, m2l_batch_path,
+                        (const LaneState &st, std::size_t count, const double *const *Ms, const Vec3 *R,
+                         double *Lt),
+                        m2l_batch_body, (st, count, Ms, R, Lt))
+
+}  // namespace
+
+Operators::Operators(int order, SimdPath path) : p_(order), S_((order + 1) * (order + 1)), path_(path) {
+  if (order < 1) throw std::invalid_argument("gcfmm: expansion order must be >= 1");
+  if (!simd_path_available(path))
+    throw std::invalid_argument(std::string("gcfmm: SIMD path ") + simd_path_name(path) + " not available");
+  if (order > kMaxOrder)
+    throw std::invalid_argument("gcfmm: expansion order must be <= " + std::to_string(kMaxOrder));
+  inv_nm_.assign(static_cast<std::size_t>((p_ + 1) * (p_ + 1)), 0.0);
+  nm1_.assign(static_cast<std::size_t>((p_ + 1) * (p_ + 1)), 0.0);
+  for (int n = 0; n <= p_; ++n)
+    for (int m = 0; m <= n; ++m) {
+      if (m < n) inv_nm_[n * (p_ + 1) + m] = 1.0 / (double(n + m) * double(n - m));
+      nm1_[n * (p_ + 1) + m] = double(n - 1 + m) * double(n - 1 - m);
+    }
+  harm_re_.assign(S_, 0.0);
+  harm_im_.assign(S_, 0.0);
+  lane_harm_.assign(2 * static_cast<std::size_t>(S_) * kBatch, 0.0);
+  lane_mult_.assign(2 * static_cast<std::size_t>(S_) * kBatch, 0.0);
+  lane_acc_.assign(2 * static_cast<std::size_t>(S_) * kBatch, 0.0);
+}
+
+// the lane state of this instance, for the batched operators of the chosen path
+LaneState Operators::lanes() {
+  return LaneState{p_, S_, inv_nm_.data(), nm1_.data(), lane_harm_.data(), lane_mult_.data(), lane_acc_.data()};
+}
+
+void Operators::regular(const Vec3 &r, int nmax, double *re, double *im) const {
+  solid_harmonics<Kind::Regular, 1>(nmax, p_, inv_nm_.data(), &r.x, &r.y, &r.z, re, im);
+  fill_negative_m<1>(nmax, re, im);
+}
+
+void Operators::irregular(const Vec3 &r, int nmax, double *re, double *im) const {
+  solid_harmonics<Kind::Irregular, 1>(nmax, p_, nm1_.data(), &r.x, &r.y, &r.z, re, im);
+  fill_negative_m<1>(nmax, re, im);
+}
+
+void Operators::symmetrize(double *a) const {
+  double *re = a, *im = a + S_;
+  for (int n = 0; n <= p_; ++n) im[idx(n, 0)] = 0.0;  // exact for real charges; removes round-off
+  fill_negative_m<1>(p_, re, im);
+}
+
+void Operators::p2m(std::size_t np, const double *x, const double *y, const double *z, const double *q,
+                    const Vec3 &c, double *M) {
+  p2m_batch(np, x, y, z, q, c, M);
+}
+
+void Operators::p2m_batch(std::size_t np, const double *x, const double *y, const double *z, const double *q,
+                          const Vec3 &c, double *M) {
+  p2m_batch_path_for(path_)(lanes(), np, x, y, z, q, c, M);
+}
+
+void Operators::l2p(const double *L, const Vec3 &r, double &pot, double &ex, double &ey, double &ez) {
+  l2p_batch(L, Vec3{}, 1, &r.x, &r.y, &r.z, &pot, &ex, &ey, &ez);
+}
+
+void Operators::l2p_batch(const double *L, const Vec3 &c, std::size_t np, const double *x, const double *y,
+                          const double *z, double *pot, double *ex, double *ey, double *ez) {
+  l2p_batch_path_for(path_)(lanes(), L, c, np, x, y, z, pot, ex, ey, ez);
+}
+
 void Operators::m2m(const double *Mc, const Vec3 &d, double *Mp) {
   double *yr = harm_re_.data(), *yi = harm_im_.data();
   regular(d, p_, yr, yi);
@@ -324,50 +409,7 @@ void Operators::m2m(const double *Mc, const Vec3 &d, double *Mp) {
 void Operators::m2l(const double *Ms, const Vec3 &R, double *Lt) { m2l_batch(1, &Ms, &R, Lt); }
 
 void Operators::m2l_batch(std::size_t count, const double *const *Ms, const Vec3 *R, double *Lt) {
-  constexpr int W = kBatch;
-  const int p = p_, S = S_;
-  double *__restrict Tr = lane_harm_.data(), *__restrict Ti = lane_harm_.data() + S * W;
-  double *__restrict Mr = lane_mult_.data(), *__restrict Mi = lane_mult_.data() + S * W;
-  double *__restrict Ar = lane_acc_.data(), *__restrict Ai = lane_acc_.data() + S * W;
-  std::fill(lane_acc_.begin(), lane_acc_.end(), 0.0);
-  for (std::size_t e0 = 0; e0 < count; e0 += W) {
-    const int nl = static_cast<int>(std::min<std::size_t>(W, count - e0));
-    // gather the multipoles (lane v = entry e0 + v; empty lanes get M = 0 and R = e_x)
-    double x[W], y[W], z[W];
-    for (int v = 0; v < W; ++v) {
-      if (v < nl) {
-        const double *m = Ms[e0 + v];
-        for (int i = 0; i < S; ++i) {
-          Mr[i * W + v] = m[i];
-          Mi[i * W + v] = m[S + i];
-        }
-        x[v] = R[e0 + v].x;
-        y[v] = R[e0 + v].y;
-        z[v] = R[e0 + v].z;
-      } else {
-        for (int i = 0; i < S; ++i) Mr[i * W + v] = Mi[i * W + v] = 0.0;
-        x[v] = 1.0;
-        y[v] = z[v] = 0.0;
-      }
-    }
-    solid_harmonics<Kind::Irregular, W>(p, p, nm1_.data(), x, y, z, Tr, Ti);
-    fill_negative_m<W>(p, Tr, Ti);
-    m2l_rows<0>(p, Mr, Mi, Tr, Ti, Ar, Ai);
-  }
-  // lane sums in a fixed order, and the sign (-1)^n of eq. (3.11)
-  double *lr = Lt, *li = Lt + S;
-  for (int n = 0; n <= p; ++n) {
-    const double sgn = (n & 1) ? -1.0 : 1.0;
-    for (int m = 0; m <= n; ++m) {
-      double sr = 0.0, si = 0.0;
-      for (int v = 0; v < W; ++v) {
-        sr += Ar[idx(n, m) * W + v];
-        si += Ai[idx(n, m) * W + v];
-      }
-      lr[idx(n, m)] += sgn * sr;
-      li[idx(n, m)] += sgn * si;
-    }
-  }
+  m2l_batch_path_for(path_)(lanes(), count, Ms, R, Lt);
 }
 
 void Operators::l2l(const double *Lp, const Vec3 &b, double *Lc) {

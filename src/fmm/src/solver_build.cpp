@@ -53,7 +53,7 @@ void Solver::Impl::build_interaction_lists() {
   } else {
     shifts.push_back({0.0, 0.0, 0.0});
   }
-  build_lists(tree, shifts, res.theta, m2l_cost(res.order), lists);
+  build_lists(tree, shifts, res.theta, m2l_cost(res.order, ops->simd_path()), lists);
 }
 
 void Solver::Impl::allocate_storage() {
@@ -82,7 +82,7 @@ void Solver::Impl::estimate_partition_costs() {
   }
   for (const auto &e : lists.m2l) {
     const Node &A = nodes[e.target];
-    const double c = m2l_cost(p) / A.count();
+    const double c = m2l_cost(p, ops->simd_path()) / A.count();
     for (std::uint32_t k = A.begin; k < A.end; ++k) cost[k] += c;
   }
   leaf_prefix.assign(tree.leaves.size() + 1, 0.0);

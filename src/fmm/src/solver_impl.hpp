@@ -43,7 +43,12 @@ inline double timed(F &&f) {
 // Cost model in units of one P2P particle pair (doc/theory.md, eq. (3.16)), used to route
 // cheap accepted pairs to P2P and to balance the work partitions; measured values in
 // doc/benchmarks.md.
-inline double m2l_cost(int p) { return 0.8 * (p + 1.0) * (p + 1.0) * (p + 1.0); }
+// The M2L coefficient depends on the instruction-set path: the AVX-512 P2P is the fastest
+// relative to M2L (doc/benchmarks.md, "Cost model per path").
+inline double m2l_cost(int p, SimdPath path) {
+  const double c = path == SimdPath::AVX512 ? 0.8 : (path == SimdPath::AVX2 ? 0.4 : 0.2);
+  return c * (p + 1.0) * (p + 1.0) * (p + 1.0);
+}
 inline double l2p_cost(int p) { return 0.25 * (p + 1.0) * (p + 1.0); }
 
 // x wrapped into [lo, lo + l)

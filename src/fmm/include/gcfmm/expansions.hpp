@@ -14,9 +14,14 @@
 #include <cstddef>
 #include <vector>
 
+#include "gcfmm/simd.hpp"
 #include "gcfmm/types.hpp"
 
 namespace gcfmm {
+
+namespace detail {
+struct LaneState;
+}
 
 //! Translation operators of order p. Holds precomputed coefficient tables (read-only after
 //! construction) and scratch space written by every operator except regular(), irregular()
@@ -28,8 +33,12 @@ namespace gcfmm {
 //! are the batched ones with a batch of one.
 class Operators {
  public:
-  explicit Operators(int order);
+  /** @param order expansion order p, 1 <= p <= kMaxOrder
+   *  @param path  instruction-set path of the batched operators (include/gcfmm/simd.hpp)
+   *  @throws std::invalid_argument on a bad order or an unavailable path */
+  explicit Operators(int order, SimdPath path = default_simd_path());
   int order() const { return p_; }
+  SimdPath simd_path() const { return path_; }  //!< instruction-set path of the batched operators
   //! number of doubles of one expansion (2 (p+1)^2)
   std::size_t size() const { return 2 * static_cast<std::size_t>(S_); }
 
@@ -82,8 +91,10 @@ class Operators {
   double m2p_potential(const double *M, const Vec3 &r);
 
  private:
+  detail::LaneState lanes();
   int p_;
   int S_;
+  SimdPath path_;
   std::vector<double> inv_nm_;  //!< 1/((n+m)(n-m)) at [n*(p+1)+m] (regular recurrence)
   std::vector<double> nm1_;     //!< (n-1+m)(n-1-m) at [n*(p+1)+m] (irregular recurrence)
   std::vector<double> harm_re_, harm_im_;  //!< scratch: harmonics of one vector (M2M, L2L, M2P)
