@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -60,6 +61,18 @@ void PeriodicFarField::parameters_for(double accuracy, int *pxy, int *pz, double
 
 void PeriodicFarField::setup(double x0, double y0, double lx, double ly, double zlo, double zhi,
                              int images, double accuracy) {
+  // one Chebyshev grid spans the whole cell in x and y, so the kernel's variation on the
+  // scale of the short side must be resolved along the long side: the parameter sets meet
+  // their accuracy up to an aspect ratio of 2 (scan in doc/fmm-far-field.md)
+  if (lx > 0 && ly > 0 && std::max(lx, ly) > kMaxAspect * std::min(lx, ly)) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "gcfmm::PeriodicFarField: the exact far field supports cells with max(lx, ly) / min(lx, ly) "
+                  "<= %g, got %g (lx = %g, ly = %g); use FarField::Average or FarField::None, or a cell closer "
+                  "to square",
+                  kMaxAspect, std::max(lx, ly) / std::min(lx, ly), lx, ly);
+    throw std::invalid_argument(buf);
+  }
   int pxy = 0, pz = 0;
   double hzl = 0;
   parameters_for(accuracy, &pxy, &pz, &hzl);

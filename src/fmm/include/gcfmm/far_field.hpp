@@ -42,6 +42,10 @@ namespace gcfmm {
  */
 class PeriodicFarField {
  public:
+  //! Largest cell aspect ratio max(lx, ly) / min(lx, ly) accepted by setup(); column heights
+  //! are not limited (the column is split into boxes; H / L = 50 is tested).
+  static constexpr double kMaxAspect = 2.0;
+
   /**
    * @brief Precompute the operator.
    * @param x0,y0,lx,ly primary cell [x0,x0+lx) x [y0,y0+ly)
@@ -49,7 +53,8 @@ class PeriodicFarField {
    *                    0.1 (zhi - zlo) + 0.1 min(lx, ly) on each side)
    * @param images      near-block shells handled by the caller (>= 1)
    * @param accuracy    requested relative RMS accuracy of the far field, in [1e-8, 1)
-   * @throws std::invalid_argument on bad arguments
+   * @throws std::invalid_argument on bad arguments, and for cells with
+   *         max(lx, ly) / min(lx, ly) > kMaxAspect (the accuracy is not met there)
    */
   void setup(double x0, double y0, double lx, double ly, double zlo, double zhi, int images,
              double accuracy);
