@@ -136,3 +136,40 @@ TEST(Robustness, CloseButDistinctPairIsExact) {
               ref.ey.data(), ref.ez.data());
   EXPECT_LT(std::abs(f.ex[3] - ref.ex[3]), 1e-9 * std::abs(ref.ex[3]));
 }
+
+// A nearly coincident pair split by the root's octant plane (different leaves), among
+// particles on a lattice whose planes hold many particles exactly on cube faces.
+TEST(Robustness, NearlyCoincidentAcrossLeavesOnALattice) {
+  gcfmm_test::Particles p;
+  for (int i = 0; i < 12; ++i)
+    for (int j = 0; j < 12; ++j)
+      for (int k = 0; k < 12; ++k) {
+        p.x.push_back(0.125 * i);
+        p.y.push_back(0.125 * j);
+        p.z.push_back(0.125 * k);
+        p.q.push_back((i + j + k) % 2 ? 1.0 : -1.0);
+      }
+  // the root cube is centred at 0.6875 (the lattice's bounding box): a pair across x = 0.6875
+  const std::size_t a = p.size(), b = a + 1;
+  for (double x : {0.6875 - 1e-13, 0.6875 + 1e-13}) {
+    p.x.push_back(x);
+    p.y.push_back(0.3);
+    p.z.push_back(0.7);
+    p.q.push_back(1.0);
+  }
+  Options o;
+  o.leaf = 8;
+  Solver s(o);
+  s.build(p.size(), p.x.data(), p.y.data(), p.z.data());
+  Field f(p.size());
+  try {
+    s.evaluate(p.q.data(), f.pot.data(), f.ex.data(), f.ey.data(), f.ez.data());
+    ADD_FAILURE() << "no exception";
+  } catch (const CoincidentParticles &e) {
+    EXPECT_EQ(e.first(), a);
+    EXPECT_EQ(e.second(), b);
+  }
+  // without the pair the lattice (many particles on cube faces, none coincident) is accepted
+  p.q[a] = p.q[b] = 0.0;
+  EXPECT_NO_THROW(s.evaluate(p.q.data(), f.pot.data(), f.ex.data(), f.ey.data(), f.ez.data()));
+}

@@ -2,6 +2,8 @@
 // (src/solver_impl.hpp).
 #include "solver_impl.hpp"
 
+#include <array>
+
 namespace gcfmm {
 
 using namespace detail;
@@ -72,56 +74,87 @@ void Solver::Impl::allocate_storage() {
 // Estimated cost per particle (eq. (3.16)), summed over leaves: the work partitions cut this
 // prefix sum into equal parts.
 void Solver::Impl::estimate_partition_costs() {
+  // cost per particle of each node's own list entries, then summed down the tree (a
+  // particle pays for the entries of every node that contains it; parents come first)
   const int p = res.order;
-  std::vector<double> cost(n, l2p_cost(p));
+  const double m2l = m2l_cost(p, ops->simd_path());
   const auto &nodes = tree.nodes;
-  for (const auto &e : lists.p2p) {
-    const Node &A = nodes[e.target];
-    const double c = nodes[e.source].count();
-    for (std::uint32_t k = A.begin; k < A.end; ++k) cost[k] += c;
-  }
-  for (const auto &e : lists.m2l) {
-    const Node &A = nodes[e.target];
-    const double c = m2l_cost(p, ops->simd_path()) / A.count();
-    for (std::uint32_t k = A.begin; k < A.end; ++k) cost[k] += c;
-  }
+  std::vector<double> own(nodes.size(), 0.0);
+  for (const auto &e : lists.p2p) own[e.target] += nodes[e.source].count();
+  for (const auto &e : lists.m2l) own[e.target] += m2l / nodes[e.target].count();
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    if (nodes[i].parent >= 0) own[i] += own[nodes[i].parent];
   leaf_prefix.assign(tree.leaves.size() + 1, 0.0);
   for (std::size_t l = 0; l < tree.leaves.size(); ++l) {
-    const Node &A = nodes[tree.leaves[l]];
-    double c = 0.0;
-    for (std::uint32_t k = A.begin; k < A.end; ++k) c += cost[k];
-    leaf_prefix[l + 1] = leaf_prefix[l] + c;
+    const std::int32_t leaf = tree.leaves[l];
+    leaf_prefix[l + 1] = leaf_prefix[l] + nodes[leaf].count() * (l2p_cost(p) + own[leaf]);
   }
 }
 
-// Pairs closer than the coincidence radius (kCoincidenceRadius h, solver.hpp), periodic
-// images included. Such a pair lies in one leaf or in a P2P list entry (an M2L pair of
-// nodes at that distance would need both nodes smaller than the radius and holding more
-// particles than the P2P threshold (3.16), i.e. coincident pairs inside them as well), so
-// the P2P entries whose bounding boxes come that close are searched pair by pair.
+// Pairs closer than r = kCoincidenceRadius (units of h, solver.hpp), periodic images
+// included. Within a leaf every pair is tested. Two particles of different leaves lie in
+// disjoint leaf cubes, and a particle and another's periodic image lie on both sides of the
+// cell boundary, so both particles of such a pair are within r of a face of their leaf cube
+// or of the cell boundary. Only those boundary particles (normally none) are compared, through
+// 8 staggered grids of cell 4 r (a pair closer than r shares a cell in at least one of them),
+// so that lattice-aligned inputs with many particles on cube faces stay O(k log k).
+// (An M2L pair of nodes that close would need nodes smaller than r holding more particles than
+// the P2P threshold (3.16): coincident pairs inside them, found here, as well.)
 void Solver::Impl::find_coincident_pairs() {
   coincident.clear();
   const auto &xs = tree.xs, &ys = tree.ys, &zs = tree.zs;
-  const double r2 = kCoincidenceRadius * kCoincidenceRadius;
-  auto gap = [](double alo, double ahi, double blo, double bhi) {
-    return std::max({alo - bhi, blo - ahi, 0.0});
+  const double r = kCoincidenceRadius, r2 = r * r;
+  auto add = [&](std::uint32_t a, std::uint32_t b) { coincident.emplace_back(std::min(a, b), std::max(a, b)); };
+  struct Point {
+    double x, y, z;
+    std::uint32_t k;
   };
-  for (const Interaction &e : lists.p2p) {
-    const Bounds &A = tree.bounds[e.target], &B = tree.bounds[e.source];
-    const Vec3 &s = lists.shifts[e.shift];
-    const double gx = gap(A.lo.x, A.hi.x, B.lo.x + s.x, B.hi.x + s.x);
-    const double gy = gap(A.lo.y, A.hi.y, B.lo.y + s.y, B.hi.y + s.y);
-    const double gz = gap(A.lo.z, A.hi.z, B.lo.z + s.z, B.hi.z + s.z);
-    if (gx * gx + gy * gy + gz * gz > r2) continue;
-    const Node &NA = tree.nodes[e.target], &NB = tree.nodes[e.source];
-    const bool same = e.target == e.source && s.x == 0.0 && s.y == 0.0;
-    for (std::uint32_t a = NA.begin; a < NA.end; ++a)
-      for (std::uint32_t b = same ? a + 1 : NB.begin; b < NB.end; ++b) {
-        const double dx = xs[a] - xs[b] - s.x, dy = ys[a] - ys[b] - s.y, dz = zs[a] - zs[b];
-        if (dx * dx + dy * dy + dz * dz <= r2) coincident.emplace_back(std::min(a, b), std::max(a, b));
+  std::vector<Point> boundary;
+  for (auto li : tree.leaves) {
+    const Node &A = tree.nodes[li];
+    const Cube &cube = tree.cubes[li];
+    for (std::uint32_t a = A.begin; a < A.end; ++a) {
+      auto d2 = [&](std::uint32_t b) {
+        const double dx = xs[a] - xs[b], dy = ys[a] - ys[b], dz = zs[a] - zs[b];
+        return dx * dx + dy * dy + dz * dz;
+      };
+      double dmin = 2.0 * r2;  // a vectorisable scan first; the pairs only where one is close
+#pragma omp simd reduction(min : dmin)
+      for (std::uint32_t b = a + 1; b < A.end; ++b) dmin = std::min(dmin, d2(b));
+      if (dmin <= r2)
+        for (std::uint32_t b = a + 1; b < A.end; ++b)
+          if (d2(b) <= r2) add(a, b);
+      const double face = std::min({cube.half - std::abs(xs[a] - cube.center.x), cube.half - std::abs(ys[a] - cube.center.y),
+                                    cube.half - std::abs(zs[a] - cube.center.z)});
+      const bool wall = periodic() && std::min({xs[a] - sx0, sx0 + slx - xs[a], ys[a] - sy0, sy0 + sly - ys[a]}) <= r;
+      if (face > r && !wall) continue;
+      for (const Vec3 &s : lists.shifts) {  // the particle and, at the cell boundary, its images
+        const Point q{xs[a] + s.x, ys[a] + s.y, zs[a], a};
+        if (s.x == 0.0 && s.y == 0.0) boundary.push_back(q);
+        else if (q.x >= sx0 - r && q.x <= sx0 + slx + r && q.y >= sy0 - r && q.y <= sy0 + sly + r) boundary.push_back(q);
       }
+    }
   }
-  // each pair once (a pair in two entries, A-B and B-A, is found twice)
+  if (boundary.size() > 1) {
+    const double cell = 4.0 * r;
+    std::vector<std::pair<std::array<double, 3>, std::uint32_t>> keys(boundary.size());
+    for (int g = 0; g < 8; ++g) {
+      const double ox = (g & 1) ? 2.0 * r : 0.0, oy = (g & 2) ? 2.0 * r : 0.0, oz = (g & 4) ? 2.0 * r : 0.0;
+      for (std::size_t i = 0; i < boundary.size(); ++i) {
+        const Point &q = boundary[i];
+        keys[i] = {{std::floor((q.x + ox) / cell), std::floor((q.y + oy) / cell), std::floor((q.z + oz) / cell)},
+                   static_cast<std::uint32_t>(i)};
+      }
+      std::sort(keys.begin(), keys.end());
+      for (std::size_t i = 0; i < keys.size(); ++i)
+        for (std::size_t j = i + 1; j < keys.size() && keys[j].first == keys[i].first; ++j) {
+          const Point &u = boundary[keys[i].second], &v = boundary[keys[j].second];
+          const double dx = u.x - v.x, dy = u.y - v.y, dz = u.z - v.z;
+          if (u.k != v.k && dx * dx + dy * dy + dz * dz <= r2) add(u.k, v.k);
+        }
+    }
+  }
+  // each pair once (found in several grids, or as a particle and as an image)
   std::sort(coincident.begin(), coincident.end());
   coincident.erase(std::unique(coincident.begin(), coincident.end()), coincident.end());
 }

@@ -17,7 +17,6 @@ void Tree::build(std::size_t n, const double *x, const double *y, const double *
   if (leaf < 1) throw std::invalid_argument("gcfmm: leaf size must be >= 1");
   nodes.clear();
   cubes.clear();
-  bounds.clear();
   leaves.clear();
   perm.resize(n);
   for (std::size_t i = 0; i < n; ++i) perm[i] = static_cast<std::uint32_t>(i);
@@ -68,7 +67,6 @@ void Tree::build(std::size_t n, const double *x, const double *y, const double *
       a[2] = std::min(a[2], zs[k]); b[2] = std::max(b[2], zs[k]);
     }
     nd.center = {0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2])};
-    bounds.push_back({{a[0], a[1], a[2]}, {b[0], b[1], b[2]}});
     double r2 = 0.0;
     for (std::uint32_t k = nd.begin; k < nd.end; ++k) {
       double dx = xs[k] - nd.center.x, dy = ys[k] - nd.center.y, dz = zs[k] - nd.center.z;

@@ -35,12 +35,6 @@ struct Cube {
   double half = 0.0;   //!< half side
 };
 
-//! Axis-aligned bounding box of a node's particles.
-struct Bounds {
-  Vec3 lo;  //!< lower corner
-  Vec3 hi;  //!< upper corner
-};
-
 //! Adaptive octree over a set of points.
 class Tree {
  public:
@@ -52,7 +46,6 @@ class Tree {
 
   std::vector<Node> nodes;          //!< all nodes, root first, children contiguous
   std::vector<Cube> cubes;          //!< geometric cube of each node (parallel to nodes)
-  std::vector<Bounds> bounds;       //!< bounding box of each node's particles (parallel to nodes)
   std::vector<std::uint32_t> perm;  //!< sorted position k holds original particle perm[k]
   std::vector<double> xs, ys, zs;   //!< sorted positions
   std::vector<std::int32_t> leaves; //!< leaf node indices in particle order
