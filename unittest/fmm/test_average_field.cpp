@@ -2,6 +2,7 @@
 // (closed-form uniform density outside the near block) against test-side quadrature and
 // physical limits, and the table comparing it with the exact far field (doc/fmm-far-field.md).
 #include "gcfmm/average_field.hpp"
+#include "gcfmm/far_field.hpp"
 #include "gcfmm/lattice_sum.hpp"
 
 #include <gtest/gtest.h>

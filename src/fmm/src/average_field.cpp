@@ -1,5 +1,6 @@
 // GRANULAR-CHARGED FMM core library (gcfmm).
-// The paper's average far field: closed forms of a uniformly charged slab and cuboid.
+// The average far field (doc/theory.md, eqs. (4.7)-(4.8)): closed forms of a uniformly
+// charged slab and cuboid.
 // Conventions: include/gcfmm/average_field.hpp and doc/fmm-far-field.md.
 #include "gcfmm/average_field.hpp"
 

@@ -38,11 +38,10 @@ void Options::validate() const {
     throw std::invalid_argument("gcfmm: bed_zhi must be > bed_zlo, got " + num(bed_zlo) + " .. " + num(bed_zhi));
 }
 
-// Calibrated model of the relative RMS force error (see doc/fmm-accuracy.md):
+// Calibrated model of the relative RMS force error (doc/theory.md, eq. (3.15)):
 //   err(p, theta) = 0.6 theta^(p+1) / (p+1)^2
-// fitted over the measurements (p = 4..14, theta = 0.5..0.7) on random free-space charges and
-// on the deposition geometry (periodic near field): it lies above every measured point with
-// p >= 5, by a factor 1.4 to 4 (smallest at low order).
+// fitted to the measurements on random free-space charges and on the deposition geometry;
+// it bounds every measured point with p >= 5 (calibration tables: doc/fmm-accuracy.md).
 double predicted_error(int order, double theta) {
   const double q = order + 1.0;
   return 0.6 * std::pow(theta, q) / (q * q);
@@ -50,20 +49,21 @@ double predicted_error(int order, double theta) {
 
 Resolved resolve(const Options &o) {
   Resolved r;
-  constexpr double kDefaultTheta = 0.6;  // fastest of 0.5/0.6/0.7 at 1e-3..1e-6 (doc/fmm-accuracy.md)
+  constexpr double kDefaultTheta = 0.6;  // the fastest of 0.5/0.6/0.7 at equal error (doc/fmm-accuracy.md)
   r.theta = o.theta > 0.0 ? o.theta : kDefaultTheta;
   if (o.order > 0) {
     r.order = o.order;
   } else {
-    // below p = 5 the model is not an upper bound in the deposition geometry (measured 1.1e-3
-    // against a prediction of 7.5e-4 at p = 4, theta = 0.5), so the automatic order starts at 5
+    // below p = 5 the model is not an upper bound in the deposition geometry
+    // (doc/fmm-accuracy.md), so the automatic order starts at 5
     r.order = 5;
     while (r.order < kMaxOrder && predicted_error(r.order, r.theta) > o.accuracy) ++r.order;
   }
   if (o.leaf > 0) {
     r.leaf = o.leaf;
   } else {
-    // balance P2P (grows with leaf) against M2L (grows with order^3..4 / leaf); measured optimum
+    // balance P2P (grows with leaf) against M2L (grows with order^3..4 / leaf); the fastest
+    // leaf per order range in doc/fmm-accuracy.md
     r.leaf = r.order <= 8 ? 64 : (r.order <= 12 ? 80 : 96);
   }
   r.estimated_error = predicted_error(r.order, r.theta);

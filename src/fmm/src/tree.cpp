@@ -1,4 +1,5 @@
-// GRANULAR-CHARGED FMM core library (gcfmm): adaptive octree.
+// GRANULAR-CHARGED FMM core library (gcfmm): adaptive octree (src/fmm/README.md, "Tree and
+// traversal").
 #include "gcfmm/tree.hpp"
 
 #include <algorithm>
@@ -15,6 +16,7 @@ void Tree::build(std::size_t n, const double *x, const double *y, const double *
   if (n > 0xFFFFFFF0u) throw std::invalid_argument("gcfmm: too many particles for one tree");
   if (leaf < 1) throw std::invalid_argument("gcfmm: leaf size must be >= 1");
   nodes.clear();
+  cubes.clear();
   leaves.clear();
   perm.resize(n);
   for (std::size_t i = 0; i < n; ++i) perm[i] = static_cast<std::uint32_t>(i);
@@ -33,12 +35,14 @@ void Tree::build(std::size_t n, const double *x, const double *y, const double *
     lo[2] = std::min(lo[2], zs[i]); hi[2] = std::max(hi[2], zs[i]);
   }
   Node root;
-  root.center = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
-  root.half = 0.5 * std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
-  root.half = root.half * (1.0 + 1e-12) + 1e-300;
+  Cube cube;
+  cube.center = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
+  cube.half = 0.5 * std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  cube.half = cube.half * (1.0 + 1e-12) + 1e-300;
   root.begin = 0;
   root.end = static_cast<std::uint32_t>(n);
   nodes.push_back(root);
+  cubes.push_back(cube);
   std::vector<std::uint32_t> scratch(n);
   split(0, leaf, scratch);
 
@@ -87,11 +91,12 @@ void Tree::build(std::size_t n, const double *x, const double *y, const double *
 
 void Tree::split(std::int32_t ni, int leaf, std::vector<std::uint32_t> &scratch) {
   const Node nd = nodes[ni];
+  const Cube cube = cubes[ni];
   if (nd.count() <= static_cast<std::uint32_t>(leaf) || nd.level >= kMaxDepth) return;
   // octant of every particle; xs/ys/zs are still in original order here
   std::uint32_t cnt[8] = {0, 0, 0, 0, 0, 0, 0, 0};
   auto octant = [&](std::uint32_t p) {
-    return (xs[p] >= nd.center.x ? 1 : 0) | (ys[p] >= nd.center.y ? 2 : 0) | (zs[p] >= nd.center.z ? 4 : 0);
+    return (xs[p] >= cube.center.x ? 1 : 0) | (ys[p] >= cube.center.y ? 2 : 0) | (zs[p] >= cube.center.z ? 4 : 0);
   };
   for (std::uint32_t k = nd.begin; k < nd.end; ++k) ++cnt[octant(perm[k])];
   std::uint32_t off[8];
@@ -102,19 +107,20 @@ void Tree::split(std::int32_t ni, int leaf, std::vector<std::uint32_t> &scratch)
     s += cnt[o];
     if (cnt[o]) ++nonempty;
   }
-  if (nonempty == 1 && nd.half < 1e-300) return;
   for (std::uint32_t k = nd.begin; k < nd.end; ++k) scratch[off[octant(perm[k])]++] = perm[k];
   std::copy(scratch.begin() + nd.begin, scratch.begin() + nd.end, perm.begin() + nd.begin);
 
   const std::int32_t first = static_cast<std::int32_t>(nodes.size());
   std::uint32_t b = nd.begin;
-  const double h = 0.5 * nd.half;
+  const double h = 0.5 * cube.half;
   for (int o = 0; o < 8; ++o) {
     if (!cnt[o]) continue;
     Node c;
-    c.half = h;
-    c.center = {nd.center.x + ((o & 1) ? h : -h), nd.center.y + ((o & 2) ? h : -h),
-                nd.center.z + ((o & 4) ? h : -h)};
+    Cube cc;
+    cc.half = h;
+    cc.center = {cube.center.x + ((o & 1) ? h : -h), cube.center.y + ((o & 2) ? h : -h),
+                 cube.center.z + ((o & 4) ? h : -h)};
+    cubes.push_back(cc);
     c.begin = b;
     c.end = b + cnt[o];
     b = c.end;

@@ -1,7 +1,8 @@
 // GRANULAR-CHARGED FMM core library (gcfmm).
-// The paper's "average field" approximation of the far field (Appendix of
-// reference/paper-charged-adhesive-packing.txt): the image cells beyond the near block are
-// replaced by a uniform charge density filling the bed height, integrated in closed form.
+// The "average field" approximation of the far field of Chen, Li, Liu, Makse, Soft Matter 12
+// (2016) 1836, Appendix, eq. (13) (doc/theory.md, eqs. (4.7)-(4.8)): the image cells beyond
+// the near block are replaced by a uniform charge density filling the bed height,
+// integrated in closed form.
 // No LAMMPS headers; only std.
 #ifndef GCFMM_AVERAGE_FIELD_HPP
 #define GCFMM_AVERAGE_FIELD_HPP
@@ -26,7 +27,7 @@ void cuboid_field(double x1, double x2, double y1, double y2, double z1, double 
                   double tz, double *pot, double e[3]);
 
 /**
- * @brief The paper's Appendix far field: a uniform charge density
+ * @brief The average far field (doc/theory.md, eq. (4.7)): a uniform charge density
  * rho = sum(q) / (lx ly (bed_zhi - bed_zlo)) filling bed_zlo <= z <= bed_zhi everywhere
  * OUTSIDE the (2 images + 1) lx x (2 images + 1) ly block centred on the primary cell
  * [x0, x0+lx) x [y0, y0+ly), integrated analytically. ADDS potential and field for targets

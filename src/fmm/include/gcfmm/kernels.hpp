@@ -7,15 +7,25 @@
 
 #include <cstddef>
 
+#include "gcfmm/simd.hpp"
+
 namespace gcfmm {
 
-/** @brief Vectorised P2P: add the potential and field of sources (xs, ys, zs, qs)[0..ns),
- *  shifted by (sx, sy, sz), at targets (xt, yt, zt)[0..nt). Structure-of-arrays inputs.
- *  Pairs with |r_i - r_j - s| = 0 are skipped. The result for each target depends only on
- *  its own position and the source range (not on the other targets). */
+/** @brief Vectorised P2P (doc/theory.md, eq. (3.1)): add the potential and field of sources
+ *  (xs, ys, zs, qs)[0..ns), shifted by (sx, sy, sz), at targets (xt, yt, zt)[0..nt).
+ *  Structure-of-arrays inputs. Pairs with |r_i - r_j - s|^2 <= r2_min are skipped (the self
+ *  term, and coincident pairs; the solver passes its coincidence radius squared). The result
+ *  for each target depends only on its own position and the source range (not on the other
+ *  targets). */
 void p2p(std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
          const double *xs, const double *ys, const double *zs, const double *qs, double sx, double sy,
-         double sz, double *pot, double *ex, double *ey, double *ez);
+         double sz, double *pot, double *ex, double *ey, double *ez, double r2_min = 0.0);
+
+/** @brief p2p() on a given instruction-set path (tests and benchmarks; p2p() uses
+ *  default_simd_path()). @throws std::invalid_argument if the path is not available. */
+void p2p_with(SimdPath path, std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
+              const double *xs, const double *ys, const double *zs, const double *qs, double sx, double sy, double sz,
+              double *pot, double *ex, double *ey, double *ez, double r2_min = 0.0);
 
 /** @brief O(N^2) free-space reference: pot_i = sum_{j != i} q_j / r_ij and E_i = -grad pot_i
  *  (outputs are overwritten). Coincident pairs are skipped. */

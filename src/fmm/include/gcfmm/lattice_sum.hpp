@@ -1,8 +1,8 @@
 // GRANULAR-CHARGED FMM core library (gcfmm).
-// 2D-periodic (x, y periodic; z open) lattice sums of the bare 1/r kernel and the exact far
-// field of all image cells beyond the near block. No LAMMPS headers; only std (Eigen is used
-// inside the library only, so that callers built with other vectorisation flags share no
-// Eigen objects with it).
+// 2D-periodic (x, y periodic; z open) lattice sums of the bare 1/r kernel: the periodic
+// Green's function G (doc/theory.md, eqs. (4.2)-(4.4)) and the far kernel R of all image
+// cells beyond the near block (eq. (4.5)). The far-field operator built on R is in
+// far_field.hpp. No LAMMPS headers; only std.
 //
 // Notation (Gaussian units, the caller multiplies by its Coulomb constant):
 //   cell periods lx, ly; area A = lx * ly; image shift n = (nx lx, ny ly, 0);
@@ -10,9 +10,6 @@
 // See doc/fmm-far-field.md for the derivations, error control and measured costs.
 #ifndef GCFMM_LATTICE_SUM_HPP
 #define GCFMM_LATTICE_SUM_HPP
-
-#include <cstddef>
-#include <vector>
 
 namespace gcfmm {
 
@@ -76,108 +73,6 @@ double green_switch_height(double lx, double ly);
  */
 void far_kernel(double dx, double dy, double dz, double lx, double ly, int images, double *r,
                 double *rx, double *ry, double *rz);
-
-/**
- * @brief Field of all image cells beyond `images` shells (max(|nx|,|ny|) > images), the
- * exact lattice sum to the requested accuracy.
- *
- * Method (black-box FMM of Fong & Darve, J. Comput. Phys. 228 (2009) 8712, applied to the
- * smooth far kernel R above): the column [zlo, zhi] (padded) is split into nb boxes of
- * full cell width and height hz <= min(lx, ly) (0.7 min(lx, ly) at 1e-8); each box
- * carries a tensor Chebyshev grid of p x p x pz nodes; charges are anterpolated to the nodes, the node potentials are
- * M_{t-s} W_s with the precomputed matrices M_o[a, b] = R(node_a - node_b + o hz e_z)
- * (translation invariant, so one matrix per box offset o, and M_{-o} = M_o^T since R is
- * even), and potential and field at the targets are the Chebyshev interpolant and its
- * derivative. R is even in dx and dy and the nodes are mirror-symmetric, so each M_o is
- * block diagonal in even/odd node combinations (4 blocks of size (p^2 pz / 4)^2; p even).
- * Cost: set-up evaluates R once per distinct |node difference| and fills nb x 4 blocks;
- * evaluate costs O(N p^2 pz + nb^2 (p^2 pz)^2 / 4), independent of the particle distribution.
- * Parameters (p, pz, hz) per accuracy and measured errors/costs: doc/fmm-far-field.md.
- *
- * Conventions: pot_i = sum_j q_j R(r_i - r_j) (all j, including j = i: R is smooth at 0 and
- * R(0) is the self-energy of i with its far images), E_i = -grad pot_i. The monopole (sheet
- * field of a net-charged layer) is kept exactly, nothing is neutralised. Because R is even,
- * the exact far field exerts zero total force on the cell: sum_i q_i E_i = 0 (the
- * interpolated one does so to the interpolation accuracy).
- *
- * Requirements: images >= 1 (with images = 0 the kernel is singular inside the cell
- * difference domain); positions inside the primary cell and the stored z range (a margin
- * of 1% of the cell size is tolerated, beyond it evaluate throws std::invalid_argument).
- */
-class PeriodicFarField {
- public:
-  /**
-   * @brief Precompute the operator.
-   * @param x0,y0,lx,ly primary cell [x0,x0+lx) x [y0,y0+ly)
-   * @param zlo,zhi     z range containing all particles (stored padded by
-   *                    0.1 (zhi - zlo) + 0.1 min(lx, ly) on each side)
-   * @param images      near-block shells handled by the caller (>= 1)
-   * @param accuracy    requested relative RMS accuracy of the far field, in [1e-8, 1)
-   * @throws std::invalid_argument on bad arguments
-   */
-  void setup(double x0, double y0, double lx, double ly, double zlo, double zhi, int images,
-             double accuracy);
-
-  /// @brief true when the stored operator does not cover this geometry (different cell, z
-  /// range outside the stored one or much smaller than it, other images or accuracy).
-  bool needs_setup(double x0, double y0, double lx, double ly, double zlo, double zhi, int images,
-                   double accuracy) const;
-
-  /**
-   * @brief ADDS far-field potential and field at targets i in [begin, end).
-   * Sources are all n particles (inside the primary cell). pot, ex, ey, ez are indexed by
-   * particle (length >= end); pot may be null.
-   * @throws std::logic_error if setup was not called; std::invalid_argument if a particle
-   *         lies outside the stored geometry.
-   */
-  void evaluate(std::size_t n, const double *x, const double *y, const double *z, const double *q,
-                std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
-                double *ez) const;
-
-  /// @brief Estimated relative RMS error of the far field: the larger of the error measured
-  /// for these parameters in the calibration (setup only) and 20 x the RMS error of the
-  /// interpolated kernel gradient over random sample pairs divided by the sheet field
-  /// 2 pi / A of a unit charge (the factor 20 covers the ratios seen in calibration).
-  double estimated_error() const { return est_error_; }
-
-  int order_xy() const { return pxy_; }           //!< Chebyshev nodes per box in x and y
-  int order_z() const { return pz_; }             //!< Chebyshev nodes per box in z
-  int boxes() const { return nb_; }               //!< number of boxes in the column
-  double box_height() const { return hz_; }       //!< height of one box
-  double stored_zlo() const { return zlo_; }      //!< lower end of the stored (padded) z range
-  double stored_zhi() const { return zhi_; }      //!< upper end of the stored (padded) z range
-  double setup_seconds() const { return setup_s_; }  //!< wall time of the last setup
-  std::size_t memory_bytes() const;               //!< bytes held by the operator
-  bool ready() const { return nb_ > 0; }          //!< setup has been called
-
-  /// @brief Choice of (p, pz, hz / min(lx, ly)) for a requested accuracy (used by setup).
-  static void parameters_for(double accuracy, int *pxy, int *pz, double *hz_over_l);
-
-  /// @brief Setup with explicit interpolation parameters (tests and tuning).
-  void setup_explicit(double x0, double y0, double lx, double ly, double zlo, double zhi,
-                      int images, int pxy, int pz, double hz_max);
-
- private:
-  static void interp_weights(double t, int p, const double *tab, double *s, double *ds);
-  void apply(const double *w, double *phi) const;  // node charges -> node potentials, (p^2 pz) x nb
-  int locate(std::size_t i, double x, double y, double z, double *tx, double *ty, double *tz) const;
-  void interpolate(const double *phi, const double *x, const double *y, const double *z,
-                   std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
-                   double *ez) const;
-  double sample_error() const;
-
-  double x0_ = 0, y0_ = 0, lx_ = 0, ly_ = 0;  //!< primary cell
-  double zlo_ = 0, zhi_ = 0;                  //!< stored (padded) z range
-  double req_zlo_ = 0, req_zhi_ = 0;          //!< z range asked for at setup
-  int images_ = -1;                           //!< near-block shells excluded
-  double accuracy_ = 0;                       //!< requested accuracy
-  int pxy_ = 0, pz_ = 0, nb_ = 0;             //!< nodes per box, boxes
-  double hz_ = 0;                             //!< box height
-  double est_error_ = 0;                      //!< sampled relative kernel error
-  double setup_s_ = 0;                        //!< set-up wall time
-  std::vector<std::vector<double>> ops_;      //!< blocks K_{o,s} (column-major) at 4 o + s, o = 0 .. nb-1
-  std::vector<double> tab_xy_, tab_z_;        //!< T_k(t_i) at the Chebyshev nodes
-};
 
 }  // namespace gcfmm
 

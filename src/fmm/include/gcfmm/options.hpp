@@ -39,7 +39,7 @@ struct Resolved {
   double estimated_error = 0.0;  //!< predicted relative RMS force error of the near field
 };
 
-/** @brief Apply the error-control rule (see src/fmm/README.md) to the options.
+/** @brief Apply the error-control rule (doc/theory.md, eq. (3.15)) to the options.
  *  @param opts validated options
  *  @return order, theta and leaf (explicit user values are kept) and the predicted error */
 Resolved resolve(const Options &opts);

@@ -5,6 +5,8 @@
 
 #include <cstddef>
 #include <memory>
+#include <stdexcept>
+#include <string>
 
 #include "gcfmm/kernels.hpp"
 #include "gcfmm/options.hpp"
@@ -29,6 +31,30 @@ struct Stats {
   double t_downward = 0.0;       //!< L2L + L2P
   double t_far = 0.0;            //!< far field beyond the image shells
 };
+
+/** @brief Thrown by Solver::evaluate when two distinct particles are closer than the
+ *  coincidence radius (kCoincidenceRadius times the solver's length unit) and either is
+ *  charged. first() and second() are the two particles' indices in the arrays given to
+ *  build() (first() < second()); the message reads "gcfmm: particles <first> and <second> are
+ *  at the same position ...". */
+class CoincidentParticles : public std::runtime_error {
+ public:
+  CoincidentParticles(std::size_t first, std::size_t second, const std::string &what)
+      : std::runtime_error(what), first_(first), second_(second) {}
+  std::size_t first() const { return first_; }    //!< smaller input index of the pair
+  std::size_t second() const { return second_; }  //!< larger input index of the pair
+
+ private:
+  std::size_t first_, second_;
+};
+
+/** @brief Coincidence radius relative to the solver's length unit h (the power of two >= the
+ *  larger period of a periodic cell, or >= the largest extent of the particles in free
+ *  space): pairs closer than kCoincidenceRadius h are treated as coincident. Positions are
+ *  stored with a rounding error of ~1e-16 h, so at this separation the direction of the pair
+ *  (and hence its field) is uncertain by ~1e-6 relative, the tightest accuracy the solver is
+ *  asked for, while the field q / d^2 is 1e20 times a typical one. */
+inline constexpr double kCoincidenceRadius = 1e-10;
 
 /** Adaptive FMM solver. Usage: Solver s(opts); s.set_box(...) (periodic); s.build(n, x, y, z);
  *  s.evaluate(q, pot, ex, ey, ez) (any number of times with new charges); s.stats(). */
@@ -55,9 +81,25 @@ class Solver {
    *  With nparts > 1 only the targets of work partition `part` (contiguous leaf ranges
    *  balanced by estimated cost, the same on every caller) are computed and all others are
    *  set to 0; the sum over parts is bit-identical to nparts = 1.
-   *  @throws std::runtime_error if two distinct particles share a position and either has
-   *  a nonzero charge (the field would be infinite), or if build() was not called. */
+   *  Any length scale works: the solver computes in coordinates relative to its length unit
+   *  h (a power of two, see kCoincidenceRadius), so results are bit-identical to those of the
+   *  unscaled arithmetic except the average far field (round-off).
+   *  @throws CoincidentParticles (a std::runtime_error) if two distinct particles are closer
+   *  than kCoincidenceRadius h and either has a nonzero charge (the field would be infinite
+   *  or meaningless); std::runtime_error if build() was not called. */
   void evaluate(const double *q, double *pot, double *ex, double *ey, double *ez, int part = 0, int nparts = 1);
+
+  /** @brief Per-particle potential u of the energy of the last evaluate(): the energy
+   *  U = 1/2 sum_i q_i u_i is the one whose gradient is minus the applied forces q_i E_i
+   *  (doc/theory.md, eq. (4.10)). u = pot, except with FarField::Average: the smeared far
+   *  images do not move with the particles (an external field for them), so the energy
+   *  whose gradient is the applied force is sum_i q_i phi_far(r_i), without the 1/2 of a
+   *  field the particles make themselves, and u holds the average far part twice. Exact
+   *  when the bed is given (Options::bed_zlo/bed_zhi); with the automatic bed the two
+   *  particles that bound it also move the bed. Written for the targets of the last
+   *  evaluate()'s part, 0 elsewhere (so the parts sum like pot).
+   *  @throws std::runtime_error if evaluate() was not called since the last build(). */
+  void energy_potential(double *u) const;
 
   /** @brief Parameters and timings of the last build()/evaluate(). */
   const Stats &stats() const;

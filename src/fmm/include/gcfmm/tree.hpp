@@ -18,7 +18,6 @@ namespace gcfmm {
 struct Node {
   Vec3 center;            //!< expansion centre: centre of the bounding box of its particles
   double radius = 0.0;    //!< max distance of its particles from `center`
-  double half = 0.0;      //!< half side of the geometric cube
   std::uint32_t begin = 0;  //!< first particle (sorted order)
   std::uint32_t end = 0;    //!< one past the last particle
   std::int32_t child = -1;  //!< index of the first child (children are contiguous), -1 for a leaf
@@ -27,6 +26,13 @@ struct Node {
   std::int32_t level = 0;   //!< depth, root = 0
   bool leaf() const { return nchild == 0; }
   std::uint32_t count() const { return end - begin; }
+};
+
+//! The geometric cube of a node: the octants are split about its centre (not the expansion
+//! centre Node::center, which is the centre of the particles' bounding box).
+struct Cube {
+  Vec3 center;         //!< centre of the cube
+  double half = 0.0;   //!< half side
 };
 
 //! Adaptive octree over a set of points.
@@ -39,6 +45,7 @@ class Tree {
   void build(std::size_t n, const double *x, const double *y, const double *z, int leaf);
 
   std::vector<Node> nodes;          //!< all nodes, root first, children contiguous
+  std::vector<Cube> cubes;          //!< geometric cube of each node (parallel to nodes)
   std::vector<std::uint32_t> perm;  //!< sorted position k holds original particle perm[k]
   std::vector<double> xs, ys, zs;   //!< sorted positions
   std::vector<std::int32_t> leaves; //!< leaf node indices in particle order

@@ -3,9 +3,6 @@
 #ifndef GCFMM_TYPES_HPP
 #define GCFMM_TYPES_HPP
 
-#include <cstddef>
-#include <cstdint>
-
 namespace gcfmm {
 
 //! A point or vector in 3D.
@@ -18,15 +15,6 @@ struct Vec3 {
 inline Vec3 operator+(const Vec3 &a, const Vec3 &b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 inline Vec3 operator-(const Vec3 &a, const Vec3 &b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 inline double norm2(const Vec3 &a) { return a.x * a.x + a.y * a.y + a.z * a.z; }
-
-//! Read-only structure-of-arrays view of particle positions (and optionally charges).
-struct ParticleView {
-  std::size_t n = 0;          //!< number of particles
-  const double *x = nullptr;  //!< x coordinates
-  const double *y = nullptr;  //!< y coordinates
-  const double *z = nullptr;  //!< z coordinates
-  const double *q = nullptr;  //!< charges (may be null where not needed)
-};
 
 }  // namespace gcfmm
 

@@ -1,0 +1,43 @@
+// GRANULAR-CHARGED FMM core library (gcfmm): macros that compile one kernel body for each
+// instruction-set path of include/gcfmm/simd.hpp (private header of src/*.cpp).
+#ifndef GCFMM_SIMD_PATHS_HPP
+#define GCFMM_SIMD_PATHS_HPP
+
+#include "gcfmm/simd.hpp"
+
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#define GCFMM_X86_DISPATCH 1
+#define GCFMM_TARGET_AVX2 __attribute__((target("avx2,fma")))
+#define GCFMM_TARGET_AVX512 __attribute__((target("avx512f,avx512dq,avx2,fma")))
+#else
+#define GCFMM_X86_DISPATCH 0
+#define GCFMM_TARGET_AVX2
+#define GCFMM_TARGET_AVX512
+#endif
+#if defined(__GNUC__)
+#define GCFMM_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define GCFMM_ALWAYS_INLINE inline
+#endif
+
+// Defines `ret name##_generic(params)`, `name##_avx2`, `name##_avx512` (the latter two only on
+// x86 with GCC/Clang), each calling the always-inlined `body(args)` compiled for its ISA, and
+// `name##_for(SimdPath)` returning the function of a path (Generic where a path is missing).
+#if GCFMM_X86_DISPATCH
+#define GCFMM_DEFINE_SIMD_PATHS(ret, name, params, body, args)                 \
+  ret name##_generic params { return body args; }                              \
+  GCFMM_TARGET_AVX2 ret name##_avx2 params { return body args; }               \
+  GCFMM_TARGET_AVX512 ret name##_avx512 params { return body args; }           \
+  using name##_fn = ret(*) params;                                             \
+  inline name##_fn name##_for(::gcfmm::SimdPath p) {                           \
+    return p == ::gcfmm::SimdPath::AVX512 ? name##_avx512                      \
+           : p == ::gcfmm::SimdPath::AVX2 ? name##_avx2 : name##_generic;      \
+  }
+#else
+#define GCFMM_DEFINE_SIMD_PATHS(ret, name, params, body, args)                 \
+  ret name##_generic params { return body args; }                              \
+  using name##_fn = ret(*) params;                                             \
+  inline name##_fn name##_for(::gcfmm::SimdPath) { return name##_generic; }
+#endif
+
+#endif

@@ -1,0 +1,156 @@
+// GRANULAR-CHARGED FMM core library (gcfmm): the solver's internal state (private header of
+// src/solver*.cpp, not installed). One evaluation is a sequence of named phases
+// (doc/architecture.md, "Data flow of one step"):
+//   build():    wrap positions -> tree -> interaction lists -> storage -> partition costs
+//               -> coincident pairs -> far-field set-up                  (solver_build.cpp)
+//   evaluate(): sort charges -> upward (P2M, M2M) -> M2L -> P2P -> downward (L2L, L2P)
+//               -> far field -> scatter to the caller's order             (solver_evaluate.cpp)
+// Each phase is one member function of Solver::Impl; the phases of evaluate() are the units
+// for threading.
+#ifndef GCFMM_SOLVER_IMPL_HPP
+#define GCFMM_SOLVER_IMPL_HPP
+
+#include "gcfmm/solver.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "gcfmm/average_field.hpp"
+#include "gcfmm/expansions.hpp"
+#include "gcfmm/far_field.hpp"
+#include "gcfmm/interaction_lists.hpp"
+#include "gcfmm/kernels.hpp"
+#include "gcfmm/tree.hpp"
+
+namespace gcfmm {
+
+namespace detail {
+using Clock = std::chrono::steady_clock;
+
+// run f() and return its wall time in seconds
+template <class F>
+inline double timed(F &&f) {
+  const auto t0 = Clock::now();
+  f();
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Cost model in units of one P2P particle pair (doc/theory.md, eq. (3.16)), used to route
+// cheap accepted pairs to P2P and to balance the work partitions; measured values in
+// doc/benchmarks.md.
+// The M2L coefficient depends on the instruction-set path: the AVX-512 P2P is the fastest
+// relative to M2L (doc/benchmarks.md, "Cost model per path").
+inline double m2l_cost(int p, SimdPath path) {
+  const double c = path == SimdPath::AVX512 ? 0.8 : (path == SimdPath::AVX2 ? 0.4 : 0.2);
+  return c * (p + 1.0) * (p + 1.0) * (p + 1.0);
+}
+inline double l2p_cost(int p) { return 0.25 * (p + 1.0) * (p + 1.0); }
+
+// x wrapped into [lo, lo + l)
+inline double wrap(double v, double lo, double l) {
+  double w = v - l * std::floor((v - lo) / l);
+  if (w >= lo + l) w -= l;  // round-off at the upper edge
+  if (w < lo) w = lo;
+  return w;
+}
+
+// The solver's length unit: the power of two >= extent (1 if the extent is zero or not
+// finite). Scaling by a power of two is exact, so the arithmetic in scaled coordinates gives
+// bit-identical results, and r^n, r^-(n+1) of the expansions stay in range at any box size.
+inline double length_unit(double extent) {
+  if (!(extent > 0.0) || !std::isfinite(extent)) return 1.0;
+  int e = 0;
+  std::frexp(extent, &e);  // extent = m 2^e, m in [0.5, 1)
+  return std::ldexp(1.0, e);
+}
+
+//! The targets of one work partition: sorted particle indices [begin, end).
+struct TargetRange {
+  std::size_t begin = 0, end = 0;
+  bool hits(const Node &A) const { return A.begin < end && A.end > begin; }
+  std::size_t first(const Node &A) const { return std::max<std::size_t>(A.begin, begin); }
+  std::size_t last(const Node &A) const { return std::min<std::size_t>(A.end, end); }
+};
+
+}  // namespace detail
+
+struct Solver::Impl {
+  Options opts;
+  Resolved res;
+  Stats stats;
+  bool box_set = false;
+  double x0 = 0.0, y0 = 0.0, lx = 0.0, ly = 0.0;  // primary cell (Periodic2D)
+  bool built = false;
+  std::size_t n = 0;
+
+  Tree tree;
+  InteractionLists lists;
+  std::unique_ptr<Operators> ops;
+  double h = 1.0, inv_h = 1.0;                // length unit (power of two) and its inverse
+  double sx0 = 0.0, sy0 = 0.0, slx = 0.0, sly = 0.0;  // the cell in units of h
+  std::vector<double> scaled_x, scaled_y, scaled_z;   // wrapped positions / h (original order)
+  std::vector<double> multipole, local;       // expansions, ops->size() doubles per node
+  std::vector<char> has_local;                // node has a nonzero local expansion
+  // charges and results in the tree's (sorted) particle order
+  std::vector<double> sorted_q, sorted_pot, sorted_ex, sorted_ey, sorted_ez;
+  std::vector<double> sorted_average_pot;     // the average far field's part of sorted_pot
+  bool evaluated = false;                     // evaluate() ran since the last build()
+  detail::TargetRange last_range;                     // targets of the last evaluate()
+  std::vector<const double *> batch_m;        // M2L batch of one target node: source multipoles
+  std::vector<Vec3> batch_r;                  // and translation vectors
+  std::vector<double> leaf_prefix;            // cumulative estimated cost over leaves
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> coincident;  // sorted indices, closer than kCoincidenceRadius h
+  double zmin = 0.0, zmax = 0.0;              // z range of all particles (units of h)
+  PeriodicFarField far;
+
+  bool periodic() const { return opts.boundary == Boundary::Periodic2D; }
+  std::size_t expansion_size() const { return ops->size(); }
+  double *multipole_of(std::size_t node) { return multipole.data() + node * expansion_size(); }
+  double *local_of(std::size_t node) { return local.data() + node * expansion_size(); }
+
+  detail::TargetRange range_of(int part, int nparts) const {
+    const std::size_t nl = tree.leaves.size();
+    auto bound = [&](int k) -> std::size_t {
+      if (k <= 0) return 0;
+      if (k >= nparts) return nl;
+      const double target = leaf_prefix.back() * double(k) / double(nparts);
+      auto it = std::lower_bound(leaf_prefix.begin(), leaf_prefix.end(), target);
+      return std::min<std::size_t>(static_cast<std::size_t>(it - leaf_prefix.begin()), nl);
+    };
+    auto start = [&](std::size_t b) -> std::size_t { return b >= nl ? n : tree.nodes[tree.leaves[b]].begin; };
+    detail::TargetRange r;
+    r.begin = start(bound(part));
+    r.end = std::max(r.begin, start(bound(part + 1)));
+    return r;
+  }
+
+  // ---- build phases ----
+  void build_tree(const double *x, const double *y, const double *z);
+  void build_interaction_lists();
+  void allocate_storage();
+  void estimate_partition_costs();
+  void find_coincident_pairs();
+  void setup_far_field();
+  // ---- evaluate phases ----
+  // f(i, node) for every node i that holds targets of the range, in node order
+  template <class F>
+  void for_target_nodes(const detail::TargetRange &t, F &&f) {
+    for (std::size_t i = 0; i < tree.nodes.size(); ++i)
+      if (t.hits(tree.nodes[i])) f(i, tree.nodes[i]);
+  }
+  void sort_charges(const double *q);
+  void upward();
+  void m2l(const detail::TargetRange &t);
+  void p2p(const detail::TargetRange &t);
+  void downward(const detail::TargetRange &t);
+  void far_field(const detail::TargetRange &t);
+};
+
+}  // namespace gcfmm
+
+#endif
