@@ -41,7 +41,8 @@ enum : int {
   EVAL_Q = 3,         // charge at the evaluation (0 outside the group)
   EVAL_FIELD = 4,     // evaluated Ex, Ey, Ez, phi (4)
   EVAL_SLOPE = 8,     // change of the far part per step, from the last two evaluations (4)
-  EVAL_COLS = 12
+  EVAL_LAST_X = 12,   // unwrapped position when a field was last applied (3)
+  EVAL_COLS = 15
 };
 
 /* ---------------------------------------------------------------------- */
@@ -284,7 +285,7 @@ void FixCoulFMM::setup(int vflag)
   // continue the schedule of the previous run (or of the restart file) when its stored field
   // still belongs to these atoms, charges and box: a run split into pieces, or continued from
   // a restart, then evaluates on the same steps as the uninterrupted run
-  if (!stored_field_valid()) last_computed = -1;
+  if (!stored_field_valid(true)) last_computed = -1;
   if (utils::strmatch(update->integrate_style, "^verlet")) {
     post_force(vflag);
   } else {
@@ -321,14 +322,16 @@ void FixCoulFMM::min_post_force(int vflag)
   last_computed = update->ntimestep;
   natoms_computed = atom->natoms;
   apply_field(vflag);
+  remember_positions();
 }
 
 /* ----------------------------------------------------------------------
    the stored field can be continued if it was evaluated for the same number of atoms, box
-   and charges (set between runs changes charges: then evaluate afresh)
+   and charges (set between runs changes charges: then evaluate afresh) and, at the start of
+   a run, if no atom was moved since the field was last applied
 ------------------------------------------------------------------------- */
 
-bool FixCoulFMM::stored_field_valid()
+bool FixCoulFMM::stored_field_valid(bool same_positions)
 {
   if (last_computed < 0 || atom->natoms != natoms_computed) return false;
   if (opts->boundary == gcfmm::Boundary::Periodic2D &&
@@ -336,9 +339,18 @@ bool FixCoulFMM::stored_field_valid()
        domain->xprd != box_computed[2] || domain->yprd != box_computed[3]))
     return false;
   int changed = 0, changed_all = 0;
+  // positions moved by a command between runs (displace_atoms, set): not the state the field
+  // was advanced for; unwrapping after a remap may differ in the last bits, hence a tolerance
+  const double tol = 1e-12 * MAX(MAX(domain->xprd, domain->yprd), domain->zprd);
+  double xu[3];
   for (int i = 0; i < atom->nlocal; i++) {
     const double q = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
     if (q != eval_state[i][EVAL_Q]) changed = 1;
+    if (same_positions && q != 0.0) {
+      domain->unmap(atom->x[i], atom->image[i], xu);
+      for (int k = 0; k < 3; k++)
+        if (fabs(xu[k] - eval_state[i][EVAL_LAST_X + k]) > tol) changed = 1;
+    }
   }
   MPI_Allreduce(&changed, &changed_all, 1, MPI_INT, MPI_MAX, world);
   return changed_all == 0;
@@ -391,6 +403,14 @@ void FixCoulFMM::post_force(int vflag)
   }
   if (check_every > 0 && !due && step % check_every == 0) measure_mts_error();
   apply_field(vflag);
+  remember_positions();
+}
+
+// where the atoms were when a field was last applied (a later run continues from there only)
+void FixCoulFMM::remember_positions()
+{
+  for (int i = 0; i < atom->nlocal; i++)
+    domain->unmap(atom->x[i], atom->image[i], &eval_state[i][EVAL_LAST_X]);
 }
 
 /* ----------------------------------------------------------------------
@@ -468,7 +488,7 @@ void FixCoulFMM::compute_field(bool with_slope)
   // changes when the tree does), and that difference divided by a short interval would be
   // extrapolated over a long one.
   const bool slope_ok = with_slope && last_computed >= 0 && step - last_computed >= every &&
-      atom->natoms == natoms_computed && stored_field_valid();
+      atom->natoms == natoms_computed && stored_field_valid(false);
   if (slope_ok && near_cutoff > 0.0) near_pair_difference(near_now);
   for (int i = 0; i < nlocal; i++) {
     double *st = eval_state[i];
@@ -519,6 +539,13 @@ void FixCoulFMM::evaluate_into(double **out, int col)
       solver->set_box(domain->boxlo[0], domain->boxlo[1], domain->xprd, domain->yprd);
     solver->build(n, gx.data(), gy.data(), gz.data());
     solver->evaluate(gq.data(), pot, ex, ey, ez, comm->me, comm->nprocs);
+    // the potential whose energy 1/2 sum q_i u_i has minus the applied forces as gradient
+    // (differs from pot only for farfield average; doc/theory.md, eq. (4.10))
+    solver->energy_potential(pot);
+  } catch (gcfmm::CoincidentParticles &e) {
+    failure = fmt::format("atoms {} and {} are at the same position (closer than {:g} of the "
+                          "solver's length unit): their Coulomb force is not defined",
+                          gtag[e.first()], gtag[e.second()], gcfmm::kCoincidenceRadius);
   } catch (std::exception &e) {
     failure = e.what();
     if (failure.empty()) failure = "unknown error";

@@ -100,10 +100,11 @@ class FixCoulFMM : public Fix {
   int ilevel_respa;    // rRESPA level at which the Coulomb force is applied (outermost)
 
   void check_other_coul_fmm_fixes();
-  bool stored_field_valid();
+  bool stored_field_valid(bool same_positions);
   void compute_field(bool with_slope);
   void near_pair_difference(double **&out);
   void advance_field();
+  void remember_positions();
   void evaluate_into(double **out, int col);
   void measure_mts_error();
   void apply_field(int vflag);

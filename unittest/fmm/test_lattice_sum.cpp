@@ -561,8 +561,7 @@ TEST(PeriodicFarField, NeedsSetupAndErrors) {
   EXPECT_TRUE(f.needs_setup(0, 0, 28, 28, 0, 20, 1, 1e-4));  // much smaller column
   double x = 14, y = 14, z = 300, q = 1, e = 0;
   EXPECT_THROW(f.evaluate(1, &x, &y, &z, &q, 0, 1, nullptr, &e, &e, &e), std::invalid_argument);
-  // set-up of the deposition geometry at the default accuracy is cheap
-  EXPECT_LT(f.setup_seconds(), 2.0);
+  // (its set-up time is a benchmark figure, doc/benchmarks.md, not a test)
 }
 
 // ---------------------------------------------------------------------------------------
