@@ -607,7 +607,7 @@ void FixCoulFMM::evaluate_into(double **out, int col)
 }
 
 /* ----------------------------------------------------------------------
-   multiple time stepping between evaluations (doc/theory.md, MTS): the far part is
+   multiple time stepping between evaluations (doc/theory.md, eqs. (5.2)-(5.3)): the far part is
    extrapolated with its slope, the field of the pairs closer than the near cutoff follows the
    atoms,
      E_i(t) = E_i(t_e) + (t - t_e) S_i + C sum_{j: |r_ij(t)| < rc} q_j [K(r_ij(t)) - K(r_ij(t_e))]
