@@ -140,7 +140,9 @@ def _energy_before_first_contact(run_dir, U0):
     ek = (vel * vel).sum(axis=1) / U0 ** 2
     jumps = np.flatnonzero(np.abs(np.diff(ek)) > 0.01)
     assert len(jumps), "no contact in the tracer's record"
-    k = int(jumps[0])
+    # the sample interval that ends at the jump may already hold the onset of the contact (the
+    # JKR snap-in pulls before the particles overlap): the free flight ends one sample earlier
+    k = int(jumps[0]) - 1
     smooth = np.abs(np.diff(ek[: k + 1])).max()
     return ek[k], k, z[0] - z[k], smooth
 
