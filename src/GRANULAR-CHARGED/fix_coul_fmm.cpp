@@ -23,6 +23,7 @@
 #include "respa.h"
 #include "update.h"
 
+#include "gcfmm/far_field.hpp"
 #include "gcfmm/options.hpp"
 #include "gcfmm/solver.hpp"
 
@@ -228,6 +229,15 @@ void FixCoulFMM::init()
     error->warning(FLERR,
                    "Fix coul/fmm is used together with a kspace style: Coulomb "
                    "interactions may be counted twice");
+  // the exact far field meets the requested accuracy only for cells close to square
+  if (opts->boundary == gcfmm::Boundary::Periodic2D && opts->farfield == gcfmm::FarField::Exact) {
+    const double aspect = MAX(domain->xprd, domain->yprd) / MIN(domain->xprd, domain->yprd);
+    if (aspect > gcfmm::PeriodicFarField::kMaxAspect)
+      error->all(FLERR,
+                 "Fix coul/fmm farfield exact supports cells with max(Lx, Ly) / min(Lx, Ly) <= "
+                 "{:g}, got {:g}: use farfield average or none, or a cell closer to square",
+                 gcfmm::PeriodicFarField::kMaxAspect, aspect);
+  }
   if (bed_given && !(opts->boundary == gcfmm::Boundary::Periodic2D &&
                      opts->farfield == gcfmm::FarField::Average))
     error->all(FLERR,

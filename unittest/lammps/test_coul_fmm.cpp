@@ -498,6 +498,11 @@ TEST(CoulFMM, ConflictingOrIgnoredSettings)
   expect_match(with({"fix a all coul/fmm farfield none bed 0 5"}),
                "bed applies only to farfield average");
   EXPECT_EQ(with({"fix a all coul/fmm farfield average bed 0 5"}), "no error");
+  // cells beyond the aspect ratio the exact far field is accurate for
+  expect_match(with({"change_box all x final 0 25 units box", "fix a all coul/fmm farfield exact"}),
+               "farfield exact supports cells with max\\(Lx, Ly\\) / min\\(Lx, Ly\\) <= 2, got 2.5");
+  EXPECT_EQ(with({"change_box all x final 0 25 units box", "fix a all coul/fmm farfield none"}),
+            "no error");
 }
 
 // with x and y periodic, only the zz virial is the lattice virial: the in-plane components
