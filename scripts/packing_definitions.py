@@ -1,9 +1,9 @@
 """phi and <Z> of finished depositions measured by the conventions the paper leaves open.
 
-    /usr/bin/python3 scripts/packing_definitions.py SWEEP_DIR
+    /usr/bin/python3 scripts/packing_definitions.py SWEEP_DIR [NAME_PART]
 
 SWEEP_DIR holds the run folders of a `granular-charged sweep` (each with final.dump and
-forces.dump). Prints mean +- sd over the runs of: phi in the analysis slab and over the whole
+forces.dump); finished runs (with result.json) whose folder name contains NAME_PART are used. Prints mean +- sd over the runs of: phi in the analysis slab and over the whole
 bed (H_p = highest particle top, or 2<z>), <Z> in the slab (geometric, force-carrying, without
 rattlers) and over all particles (with or without floor contacts). doc/reproduction.md."""
 import glob, sys, statistics as st
@@ -12,7 +12,10 @@ sys.path.insert(0, str(__import__('pathlib').Path(__file__).resolve().parents[1]
 from granular_charged import packing
 
 rows = {}
+part = sys.argv[2] if len(sys.argv) > 2 else ''
 for d in sorted(glob.glob(f'{sys.argv[1].rstrip("/")}/*/')):
+    if part not in d or not glob.glob(d + 'result.json'):
+        continue
     snap = packing.read_dump(d + 'final.dump', last_only=True)
     rp = float(snap['radius'][0]); z = np.asarray(snap['z']); r = np.asarray(snap['radius'])
     L = snap.box[0][1] - snap.box[0][0] if hasattr(snap, 'box') else None
