@@ -37,6 +37,9 @@ for d in sorted(glob.glob(f'{sys.argv[1].rstrip("/")}/*/')):
         'slab phi': packing.phi_slab(snap, zlo, zhi),
         'whole bed phi, H = highest top': vol / (Lx * Ly * (z + r).max()),
         'whole bed phi, H = 2<z>': vol / (Lx * Ly * 2 * z.mean()),
+        # an area-independent height: the mean over columns of 2 r_p x 2 r_p of the top sphere
+        'whole bed phi, H = mean surface height': vol / (Lx * Ly * np.nanmean(
+            packing.surface_heights(snap, 2 * rp))),
         'slab <Z> geometric': Z_all[inslab].mean(),
         '<Z> all particles': Z_all.mean(),
         '<Z> all, floor contacts counted': (Z_all + floor).mean(),
