@@ -265,10 +265,11 @@ void FixCoulFMM::init()
   }
   logged = false;
 
-  // near refresh: a full list of the pairs closer than the near cutoff, ghosts out to it
-  if (near_cutoff > 0.0) {
-    if (every == 1 && comm->me == 0)
-      error->warning(FLERR, "Fix coul/fmm {}: near has no effect with every 1", id);
+  // near refresh: a full list of the pairs closer than the near cutoff, ghosts out to it; with
+  // every 1 each step is an evaluation, so neither the list nor a slope is ever used
+  if (near_cutoff > 0.0 && every == 1 && comm->me == 0)
+    error->warning(FLERR, "Fix coul/fmm {}: near has no effect with every 1", id);
+  if (near_cutoff > 0.0 && every > 1) {
     auto *req = neighbor->add_request(this, NeighConst::REQ_FULL);
     req->set_cutoff(near_cutoff);
     const double ghost = near_cutoff + neighbor->skin;
@@ -497,8 +498,9 @@ void FixCoulFMM::compute_field(bool with_slope)
   // Only over a full interval: two evaluations differ also by the solver's own error (which
   // changes when the tree does), and that difference divided by a short interval would be
   // extrapolated over a long one.
-  const bool slope_ok = with_slope && last_computed >= 0 && step - last_computed >= every &&
-      atom->natoms == natoms_computed && stored_field_valid(false);
+  const bool slope_ok = with_slope && every > 1 && last_computed >= 0 &&
+      step - last_computed >= every && atom->natoms == natoms_computed &&
+      stored_field_valid(false);
   if (slope_ok && near_cutoff > 0.0) near_pair_difference(near_now);
   for (int i = 0; i < nlocal; i++) {
     double *st = eval_state[i];
