@@ -49,7 +49,8 @@ enum : int {
 /* ---------------------------------------------------------------------- */
 
 FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), opts(new gcfmm::Options), solver_boundary(-1), every(1), extrapolate(true), near_cutoff(0.0), last_computed(-1),
+    Fix(lmp, narg, arg), opts(new gcfmm::Options), solver_boundary(-1), every(1), tolerance(0.0),
+    stride(1), mts_estimate(-1.0), nevaluations(0), extrapolate(true), near_cutoff(0.0), last_computed(-1),
     natoms_computed(-1), box_computed{0.0, 0.0, 0.0, 0.0}, bed_given(false), energy_local(0.0),
     energy_all(0.0), energy_summed(false), field(nullptr), eval_state(nullptr),
     near_delta(nullptr), nmax_ghost(0), list(nullptr), check_every(0), fresh(nullptr),
@@ -59,8 +60,8 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
 {
   scalar_flag = 1;
   extscalar = 1;
-  vector_flag = 1;    // diagnostics: solver (error estimate, order, M2L, P2P), MTS check
-  size_vector = 7;
+  vector_flag = 1;    // diagnostics: solver (error estimate, order, M2L, P2P), MTS check, schedule
+  size_vector = 10;
   extvector = 0;
   global_freq = 1;
   energy_global_flag = 1;
@@ -145,6 +146,13 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
       every = utils::inumeric(FLERR, arg[iarg + 1], false, lmp);
       if (every < 1) error->all(FLERR, iarg + 1, "Fix coul/fmm every must be >= 1, got {}", every);
       iarg += 2;
+    } else if (key == "tolerance") {
+      need(1);
+      tolerance = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
+      if (!(tolerance >= 0.0 && tolerance < 1.0))
+        error->all(FLERR, iarg + 1, "Fix coul/fmm tolerance must be in [0, 1), got {}",
+                   arg[iarg + 1]);
+      iarg += 2;
     } else if (key == "check") {
       need(1);
       check_every = utils::inumeric(FLERR, arg[iarg + 1], false, lmp);
@@ -169,6 +177,13 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
     error->all(FLERR,
                "Fix coul/fmm farfield exact needs images >= 1 (the far-field kernel of "
                "the exact lattice sum is singular inside the cell for images 0)");
+  if (tolerance > 0.0 && every < 2)
+    error->all(FLERR, "Fix coul/fmm tolerance {} needs every > 1 (the largest evaluation interval)",
+               tolerance);
+  // adaptive: the interval is a power of two (then the evaluation steps of a shorter interval
+  // include those of a longer one) starting from 1; every is the largest
+  if (tolerance > 0.0) every = 1 << (int) std::floor(std::log2((double) every));
+  stride = tolerance > 0.0 ? 1 : every;
   try {
     opts->validate();
   } catch (std::exception &e) {
@@ -269,6 +284,11 @@ void FixCoulFMM::init()
   // every 1 each step is an evaluation, so neither the list nor a slope is ever used
   if (near_cutoff > 0.0 && every == 1 && comm->me == 0)
     error->warning(FLERR, "Fix coul/fmm {}: near has no effect with every 1", id);
+  if (tolerance > 0.0 && comm->me == 0 && !logged)
+    utils::logmesg(lmp,
+                   "Fix coul/fmm {}: evaluation interval adapted between 1 and {} steps to a "
+                   "time-stepping error of {:.3g}\n",
+                   id, every, tolerance);
   if (near_cutoff > 0.0 && every > 1) {
     auto *req = neighbor->add_request(this, NeighConst::REQ_FULL);
     req->set_cutoff(near_cutoff);
@@ -296,7 +316,10 @@ void FixCoulFMM::setup(int vflag)
   // continue the schedule of the previous run (or of the restart file) when its stored field
   // still belongs to these atoms, charges and box: a run split into pieces, or continued from
   // a restart, then evaluates on the same steps as the uninterrupted run
-  if (!stored_field_valid(true)) last_computed = -1;
+  if (!stored_field_valid(true)) {
+    last_computed = -1;
+    if (tolerance > 0.0) stride = 1;
+  }
   if (utils::strmatch(update->integrate_style, "^verlet")) {
     post_force(vflag);
   } else {
@@ -400,13 +423,14 @@ void FixCoulFMM::post_force(int vflag)
 {
   v_init(vflag);
   const bigint step = update->ntimestep;
-  // evaluate on the steps that are multiples of every (a schedule that does not depend on where
-  // a run starts), and whenever atoms were added or removed (e.g. fix deposit): a new atom must
-  // feel, and exert, the Coulomb force from its first step
+  // evaluate on the steps that are multiples of the interval (every, or with tolerance the
+  // adapted power of two: a schedule that does not depend on where a run starts, since the
+  // interval is part of the restart state), and whenever atoms were added or removed (e.g. fix
+  // deposit): a new atom must feel, and exert, the Coulomb force from its first step
   const bool due = last_computed < 0 || atom->natoms != natoms_computed ||
-      (step % every == 0 && step != last_computed);
+      (step % stride == 0 && step != last_computed);
   if (due) {
-    compute_field(extrapolate);
+    compute_field(true);
     last_computed = step;
     natoms_computed = atom->natoms;
   } else if (every > 1) {
@@ -480,33 +504,60 @@ void FixCoulFMM::gather_charges()
 }
 
 /* ----------------------------------------------------------------------
-   evaluate the field at every charged atom: each rank computes one work partition of the
-   targets, an Allreduce assembles the result (every target is computed by exactly one rank,
-   so 1 and N ranks agree to the last bit for the same atom order)
+   how the stored evaluation relates to the atoms now: SAME atoms and charges in the same box,
+   atoms ADDED (e.g. by fix deposit) with the others unchanged, or NONE (nothing to continue)
+------------------------------------------------------------------------- */
+
+FixCoulFMM::Continuity FixCoulFMM::field_continuity()
+{
+  if (last_computed < 0 || atom->natoms < natoms_computed) return Continuity::NONE;
+  if (opts->boundary == gcfmm::Boundary::Periodic2D &&
+      (domain->boxlo[0] != box_computed[0] || domain->boxlo[1] != box_computed[1] ||
+       domain->xprd != box_computed[2] || domain->yprd != box_computed[3]))
+    return Continuity::NONE;
+  // an atom created since the evaluation has charge 0 in eval_state (set_arrays)
+  const bool added = atom->natoms > natoms_computed;
+  int changed = 0, changed_all = 0;
+  for (int i = 0; i < atom->nlocal; i++) {
+    const double q = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
+    const double q_then = eval_state[i][EVAL_Q];
+    if (q != q_then && !(added && q_then == 0.0)) changed = 1;
+  }
+  MPI_Allreduce(&changed, &changed_all, 1, MPI_INT, MPI_MAX, world);
+  if (changed_all) return Continuity::NONE;
+  return added ? Continuity::ADDED : Continuity::SAME;
+}
+
+/* ----------------------------------------------------------------------
+   a full evaluation (doc/theory.md, eqs. (5.2)-(5.4)). With the same atoms as at the last
+   evaluation it first measures the error the time stepping had reached: the field that would
+   have been applied now (stored field + extrapolation + near refresh) against the new one.
+   The slope of the far part comes from the last two evaluations, S = (E(t_e) - E(t_p) - D) /
+   (t_e - t_p), D the near-pair difference over t_p -> t_e (same pairs at both ends), and only
+   over a whole interval: two evaluations also differ by the solver's own error (which changes
+   when the tree does), and that difference divided by a short interval would be extrapolated
+   over a long one. Otherwise the slope is kept (after a shortened interval, or for the atoms
+   that were there before an insertion: a particle inserted far above the others changes their
+   field by a nearly constant amount) or zeroed (nothing to continue; a minimizer step).
 ------------------------------------------------------------------------- */
 
 void FixCoulFMM::compute_field(bool with_slope)
 {
   const int nlocal = atom->nlocal;
   const bigint step = update->ntimestep;
-  // the far part changes smoothly between evaluations of the same atoms: its slope from the
-  // last two evaluations extrapolates it (not across an insertion, a minimizer step or a
-  // changed set of charges). Far part: the field minus that of the pairs now closer than the
-  // near cutoff, for the same pairs at both evaluations (a pair crossing the cutoff would
-  // otherwise enter the slope as a jump): slope = (E(t_e) - E(t_p) - D) / (t_e - t_p) with D
-  // the near-pair difference of the refresh, taken over t_p -> t_e.
-  // Only over a full interval: two evaluations differ also by the solver's own error (which
-  // changes when the tree does), and that difference divided by a short interval would be
-  // extrapolated over a long one.
-  const bool slope_ok = with_slope && every > 1 && last_computed >= 0 &&
-      step - last_computed >= every && atom->natoms == natoms_computed &&
-      stored_field_valid(false);
-  if (slope_ok && near_cutoff > 0.0) near_pair_difference(near_now);
+  const Continuity cont = (with_slope && every > 1) ? field_continuity() : Continuity::NONE;
+  const bool same = cont == Continuity::SAME;
+  const double steps = same ? (double) (step - last_computed) : 0.0;
+  const bool new_slope = same && extrapolate && step - last_computed >= stride;
+  if (same && near_cutoff > 0.0) near_pair_difference(near_now);
   for (int i = 0; i < nlocal; i++) {
     double *st = eval_state[i];
+    const bool keep_slope = cont != Continuity::NONE && extrapolate;
     for (int k = 0; k < 4; k++) {
-      st[EVAL_SLOPE + k] = st[EVAL_FIELD + k];    // E(t_p) + D until the new evaluation is in
-      if (slope_ok && near_cutoff > 0.0) st[EVAL_SLOPE + k] += near_now[i][k];
+      // the field the time stepping would have applied now (overwritten below)
+      field[i][k] = st[EVAL_FIELD + k] + (keep_slope ? steps * st[EVAL_SLOPE + k] : 0.0) +
+          (same && near_cutoff > 0.0 ? near_now[i][k] : 0.0);
+      if (!keep_slope) st[EVAL_SLOPE + k] = 0.0;
     }
     domain->unmap(atom->x[i], atom->image[i], &st[EVAL_X]);
     st[EVAL_Q] = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
@@ -516,16 +567,48 @@ void FixCoulFMM::compute_field(bool with_slope)
   box_computed[2] = domain->xprd;
   box_computed[3] = domain->yprd;
   evaluate_into(eval_state, EVAL_FIELD);
+  nevaluations++;
 
-  const double steps_between = slope_ok ? (double) (step - last_computed) : 1.0;
+  double sums[2] = {0.0, 0.0};
   for (int i = 0; i < nlocal; i++) {
     double *st = eval_state[i];
+    const double q2 = st[EVAL_Q] * st[EVAL_Q];
     for (int k = 0; k < 4; k++) {
-      st[EVAL_SLOPE + k] =
-          slope_ok ? (st[EVAL_FIELD + k] - st[EVAL_SLOPE + k]) / steps_between : 0.0;
+      const double predicted = field[i][k];
+      if (k < 3) {
+        sums[0] += q2 * (predicted - st[EVAL_FIELD + k]) * (predicted - st[EVAL_FIELD + k]);
+        sums[1] += q2 * st[EVAL_FIELD + k] * st[EVAL_FIELD + k];
+      }
+      // E(t_p) + D = predicted - steps S_old
+      if (new_slope)
+        st[EVAL_SLOPE + k] =
+            (st[EVAL_FIELD + k] - (predicted - steps * st[EVAL_SLOPE + k])) / steps;
       field[i][k] = st[EVAL_FIELD + k];
     }
   }
+  if (same) {
+    double all[2];
+    MPI_Allreduce(sums, all, 2, MPI_DOUBLE, MPI_SUM, world);
+    adapt_stride(all[1] > 0.0 ? sqrt(all[0] / all[1]) : 0.0);
+  }
+}
+
+/* ----------------------------------------------------------------------
+   keyword tolerance: halve the interval while the measured error exceeds the tolerance,
+   double it when even the doubled interval would stay below half of it (doc/theory.md,
+   eq. (5.4): the error grows as stride^2 with extrapolation, as stride without)
+------------------------------------------------------------------------- */
+
+void FixCoulFMM::adapt_stride(double error)
+{
+  mts_estimate = error;
+  if (tolerance <= 0.0) return;
+  const double growth = extrapolate ? 4.0 : 2.0;    // error factor per doubling
+  while (error > tolerance && stride > 1) {
+    stride /= 2;
+    error /= growth;
+  }
+  if (mts_estimate * growth < 0.5 * tolerance && 2 * stride <= every) stride *= 2;
 }
 
 /* ----------------------------------------------------------------------
@@ -782,7 +865,8 @@ double FixCoulFMM::compute_scalar()
    4: particle pairs summed directly (all of the last evaluation, the same on every rank);
    keyword check: 5 the last measured MTS error, 6 the largest, 7 that of all checks together
    (sums of squares over all checks: weighted by the field, unlike the largest, which a
-   check at a nearly vanishing field can dominate)
+   check at a nearly vanishing field can dominate); 8 the evaluation interval now, 9 the MTS
+   error measured at the last scheduled evaluation (-1: none yet), 10 evaluations so far
 ------------------------------------------------------------------------- */
 
 double FixCoulFMM::compute_vector(int n)
@@ -790,6 +874,9 @@ double FixCoulFMM::compute_vector(int n)
   if (n == 4) return check_last;
   if (n == 5) return check_max;
   if (n == 6) return check_den > 0.0 ? sqrt(check_num / check_den) : 0.0;
+  if (n == 7) return (double) stride;
+  if (n == 8) return mts_estimate;
+  if (n == 9) return (double) nevaluations;
   if (!solver) return 0.0;
   const auto &st = solver->stats();
   switch (n) {
@@ -875,20 +962,21 @@ void FixCoulFMM::unpack_forward_comm(int n, int first, double *buf_in)
 void FixCoulFMM::write_restart(FILE *fp)
 {
   if (comm->me == 0) {
-    double list_out[7] = {(double) last_computed, (double) natoms_computed, box_computed[0],
+    double list_out[9] = {(double) last_computed, (double) natoms_computed, box_computed[0],
                           box_computed[1],        box_computed[2],          box_computed[3],
-                          (double) every};
+                          (double) every,         tolerance,                (double) stride};
     int size = sizeof(list_out);
     fwrite(&size, sizeof(int), 1, fp);
-    fwrite(list_out, sizeof(double), 7, fp);
+    fwrite(list_out, sizeof(double), 9, fp);
   }
 }
 
 void FixCoulFMM::restart(char *buf)
 {
   auto *list_in = (double *) buf;
-  // a different every gives a different schedule: evaluate afresh
-  if ((int) list_in[6] != every) return;
+  // a different every or tolerance gives a different schedule: evaluate afresh
+  if ((int) list_in[6] != every || list_in[7] != tolerance) return;
+  stride = (int) list_in[8];
   last_computed = (bigint) list_in[0];
   natoms_computed = (bigint) list_in[1];
   for (int k = 0; k < 4; k++) box_computed[k] = list_in[2 + k];

@@ -64,7 +64,11 @@ class FixCoulFMM : public Fix {
   std::unique_ptr<gcfmm::Options> opts;    // solver options from the keywords
   std::unique_ptr<gcfmm::Solver> solver;
   int solver_boundary;    // the gcfmm::Boundary the solver was made for
-  int every;                 // full evaluation on steps that are multiples of every
+  int every;                 // fixed: evaluate on multiples of every; adaptive: largest stride
+  double tolerance;          // adaptive schedule: MTS error allowed per interval (0: fixed)
+  int stride;                // evaluations on the steps that are multiples of stride
+  double mts_estimate;       // MTS error measured at the last scheduled evaluation (-1: none)
+  bigint nevaluations;       // evaluations so far (diagnostic)
   bool extrapolate;          // between evaluations extrapolate the far part linearly
   double near_cutoff;        // pairs closer than this are refreshed every step (0: off)
   bigint last_computed;      // step of the last FMM evaluation (-1: none yet)
@@ -101,7 +105,10 @@ class FixCoulFMM : public Fix {
 
   void check_other_coul_fmm_fixes();
   bool stored_field_valid(bool same_positions);
+  enum class Continuity { NONE, SAME, ADDED };
+  Continuity field_continuity();
   void compute_field(bool with_slope);
+  void adapt_stride(double error);
   void near_pair_difference(double **&out);
   void advance_field();
   void remember_positions();

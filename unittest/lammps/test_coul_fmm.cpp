@@ -269,6 +269,8 @@ TEST(CoulFMM, BadInput)
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm every 0"), "every must be >= 1, got 0");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm near -1"), "near cutoff must be >= 0, got -1");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm check -1"), "check must be >= 0, got -1");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm tolerance -1e-4 every 8"), "tolerance must be in \\[0, 1\\), got -1e-4");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm tolerance 1e-4"), "tolerance 0.0001 needs every > 1");
 }
 
 // per-atom output (Ex, Ey, Ez, phi), every N, fix_modify virial, dielectric
@@ -611,6 +613,76 @@ TEST(CoulFMM, ExtrapolationFollowsSmoothMotion)
               frozen, extrapolated);
   EXPECT_GT(frozen, 1e-7);
   EXPECT_LT(extrapolated, 0.1 * frozen);
+}
+
+// keyword tolerance: the interval adapts to the error the time stepping reaches, measured at
+// each evaluation (field that would have been applied against the new one). A loose tolerance
+// lets it grow beyond 1 with the checked error within the tolerance; a tolerance below what any
+// interval of 2 can reach brings it down to 1 (every step evaluated, nothing left to check).
+// 1e-10 accuracy: the solver's own error must not enter the measured time-stepping error.
+TEST(CoulFMM, ToleranceAdaptsTheInterval)
+{
+  auto run = [](const std::string &tolerance) {
+    Lmp l;
+    moving_charges(l);
+    // heavy: no pair of opposite charges collapses within the run (the atom IDs, hence the
+    // charges, depend on the number of ranks)
+    l.cmds({"mass 1 100000.0",
+            "fix fmm all coul/fmm accuracy 1e-10 every 64 near 5.0 check 3 tolerance " +
+                tolerance,
+            "run 120 post no"});
+    return std::vector<double>{l.var("f_fmm[7]"), l.var("f_fmm[8]"), l.var("f_fmm[9]"),
+                               l.var("f_fmm[10]")};
+  };
+  const auto loose = run("1e-4"), tight = run("1e-12");
+  std::printf("[ tolerance ] 1e-4: checked %.3g, stride %g, last estimate %.3g, %g evaluations "
+              "in 120 steps; 1e-12: stride %g, %g evaluations\n",
+              loose[0], loose[1], loose[2], loose[3], tight[1], tight[3]);
+  EXPECT_GT(loose[1], 2.0);
+  EXPECT_LT(loose[3], 60.0);
+  // the estimate is the error at the end of an interval, where it is largest: the checks,
+  // taken anywhere inside intervals, stay below the tolerance
+  EXPECT_LE(loose[0], 1e-4);
+  EXPECT_GT(loose[0], 0.0);
+  EXPECT_LE(loose[2], 1e-4);
+  EXPECT_EQ(tight[1], 1.0);
+  EXPECT_GE(tight[3], 110.0);
+}
+
+// the adapted interval is part of the state: a run split anywhere evaluates on the same steps
+// as the uninterrupted one (to round-off), and so does one continued from a restart file in a
+// new instance (there the near pairs are summed in another order: round-off grows over the
+// steps after the restart, ~1e-12 after 31 steps with a fixed every too, hence 1e-10 after 10).
+// A final run 0 wraps every copy the same way before positions are compared.
+TEST(CoulFMM, ToleranceScheduleIndependentOfRunSplit)
+{
+  const std::string fix = "fix fmm all coul/fmm accuracy 1e-6 every 32 near 6.0 tolerance 1e-4";
+  std::vector<double> straight, split, restarted;
+  double evaluations = 0.0;
+  {
+    Lmp l;
+    moving_charges(l);
+    l.cmds({fix, "run 40 post no", "run 0 post no"});
+    straight = gather(l, "x", 3);
+    evaluations = l.var("f_fmm[10]");
+  }
+  {
+    Lmp l;
+    moving_charges(l);
+    l.cmds({fix, "run 17 post no", "run 13 post no", "write_restart coul_fmm_tol.restart",
+            "run 10 post no", "run 0 post no"});
+    split = gather(l, "x", 3);
+    EXPECT_EQ(l.var("f_fmm[10]"), evaluations);
+  }
+  {
+    Lmp l;
+    l.cmds({"read_restart coul_fmm_tol.restart", "fix nve all nve", fix, "run 10 post no",
+            "run 0 post no"});
+    restarted = gather(l, "x", 3);
+  }
+  std::remove("coul_fmm_tol.restart");
+  EXPECT_LT(rel_rms(split, straight), 1e-14);
+  EXPECT_LT(rel_rms(restarted, straight), 1e-10);
 }
 
 // farfield average with a net-charged layer: the reported energy is the one whose gradient is
