@@ -134,6 +134,30 @@ TEST(Solver, DepositionPeriodicNearFieldMeetsAccuracy) {
   EXPECT_LT(gcfmm_test::force_error(p.q, f0, ref0), 1e-4);
 }
 
+// A request is delivered, not overshot: from 1e-2 to 1e-3 (orders 3 to 5) the measured error
+// lies within [0.1, 1] x accuracy in free space and in the deposition geometry, so a loose
+// request costs a low order (before, the automatic order started at 5: 1e-2 gave 3e-4).
+// Measured ratios 0.14-0.58 (doc/fmm-accuracy.md, "Low orders"; at 3e-2, order 2, free space
+// gives 0.09-0.14); the bounds are the target.
+TEST(Solver, LooseRequestsAreDeliveredNotOvershot) {
+  auto cube = gcfmm_test::random_cube(2000, 105);
+  Field ref_cube = direct(cube);
+  auto dep = gcfmm_test::deposition(2000, 106);
+  const double lx = 28.0;
+  Field ref_dep = direct_img(dep, lx, 1);
+  for (double acc : {1e-2, 3e-3, 1e-3}) {
+    Options o;
+    o.accuracy = acc;
+    Stats st;
+    const double e_cube = gcfmm_test::force_error(cube.q, free_fmm(cube, o, &st), ref_cube);
+    EXPECT_LT(e_cube, acc) << "free space, order " << st.order;
+    EXPECT_GT(e_cube, 0.1 * acc) << "free space, order " << st.order;
+    const double e_dep = gcfmm_test::force_error(dep.q, periodic_fmm(dep, periodic_opts(acc, 1), lx, &st), ref_dep);
+    EXPECT_LT(e_dep, acc) << "deposition, order " << st.order;
+    EXPECT_GT(e_dep, 0.1 * acc) << "deposition, order " << st.order;
+  }
+}
+
 // Explicit order/theta/leaf are honoured and the error falls with the order.
 TEST(Solver, ExplicitOrderConverges) {
   auto p = gcfmm_test::random_cube(2000, 104);

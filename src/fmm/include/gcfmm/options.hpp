@@ -14,6 +14,8 @@ enum class FarField { None, Average, Exact };
 
 //! Largest expansion order accepted by Options::validate().
 inline constexpr int kMaxOrder = 30;
+// lowest order the automatic choice takes (p = 1 leaves too few terms for the error model)
+inline constexpr int kMinAutoOrder = 2;
 
 //! Solver options. Zero means "choose from accuracy" for order, theta and leaf.
 struct Options {
