@@ -630,8 +630,12 @@ void FixCoulFMM::evaluate_into(double **out, int col)
 
   std::string failure;
   try {
-    if (opts->boundary == gcfmm::Boundary::Periodic2D)
+    if (opts->boundary == gcfmm::Boundary::Periodic2D) {
       solver->set_box(domain->boxlo[0], domain->boxlo[1], domain->xprd, domain->yprd);
+      // with boundary f in z every atom stays in the box: one far-field set-up for the run
+      // instead of one each time the charges' z range grows (e.g. during a deposition)
+      solver->set_z_range(domain->boxlo[2], domain->boxhi[2]);
+    }
     solver->build(n, gx.data(), gy.data(), gz.data());
     solver->evaluate(gq.data(), pot, ex, ey, ez, comm->me, comm->nprocs);
     // the potential whose energy 1/2 sum q_i u_i has minus the applied forces as gradient

@@ -5,6 +5,7 @@
 #include "gcfmm/far_field.hpp"
 
 #include <Eigen/Dense>
+#include <Eigen/SVD>
 
 #include <algorithm>
 #include <chrono>
@@ -81,8 +82,10 @@ void PeriodicFarField::setup(double x0, double y0, double lx, double ly, double 
   // the 28 x 20 thin-layer test).
   if (std::max(lx, ly) > 1.04 * std::min(lx, ly)) pxy += 2;
   setup_explicit(x0, y0, lx, ly, zlo, zhi, images, pxy, pz, hzl * std::min(lx, ly));
+  compress(kCompressionPerAccuracy * accuracy);
   accuracy_ = accuracy;
-  est_error_ = std::max(est_error_, kParams[param_index(accuracy)].measured);
+  // the sample sees the compressed operator
+  est_error_ = std::max(20.0 * sample_error(), kParams[param_index(accuracy)].measured);
 }
 
 bool PeriodicFarField::needs_setup(double x0, double y0, double lx, double ly, double zlo,
@@ -265,11 +268,33 @@ void PeriodicFarField::setup_explicit(double x0, double y0, double lx, double ly
           }
     }
 
+  rank_.assign(4 * static_cast<std::size_t>(nb_), nh);
   // sampled kernel error, scaled by 20 (the ratio of the far-field error to this sample in the
   // calibration scan: doc/fmm-far-field.md)
   est_error_ = 20.0 * sample_error();
   accuracy_ = 0.0;
   setup_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+}
+
+void PeriodicFarField::compress(double rel_tol) {
+  // K_{o,s} = U S V^T truncated where sigma_k <= rel_tol sigma_1, stored as U and W = S V^T
+  // when that halves the work (doc/theory.md, after eq. (4.6)); the blocks are smooth kernels between
+  // boxes, so their rank falls fast with the box offset o
+  const int nh = pxy_ * pxy_ * pz_ / 4;
+  for (std::size_t k = 0; k < ops_.size(); ++k) {
+    const Eigen::Map<const Eigen::MatrixXd> m(ops_[k].data(), nh, nh);
+    const Eigen::BDCSVD<Eigen::MatrixXd> svd(m, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    const auto &sv = svd.singularValues();
+    int r = 0;
+    while (r < sv.size() && sv[r] > rel_tol * sv[0]) ++r;
+    if (2 * r >= nh) continue;
+    std::vector<double> packed(2 * static_cast<std::size_t>(nh) * r);
+    Eigen::Map<Eigen::MatrixXd>(packed.data(), nh, r) = svd.matrixU().leftCols(r);
+    Eigen::Map<Eigen::MatrixXd>(packed.data() + static_cast<std::size_t>(nh) * r, r, nh) =
+        sv.head(r).asDiagonal() * svd.matrixV().leftCols(r).transpose();
+    ops_[k].swap(packed);
+    rank_[k] = r;
+  }
 }
 
 namespace {
@@ -325,18 +350,34 @@ void PeriodicFarField::apply(const double *wp, double *phip, int src_lo, int src
   // (K_{-o} = K_o^T, doc/theory.md, eq. (4.6)); w is zero outside the source boxes.
   const int nn = pxy_ * pxy_ * pz_, nh = nn / 4;
   const Eigen::Map<const Eigen::MatrixXd> w(wp, nn, nb_);
-  Eigen::MatrixXd v[4], u[4], phi;
+  Eigen::MatrixXd v[4], u[4], phi, tmp;
   to_sym(pxy_, pz_, w, v);
   for (int sym = 0; sym < 4; ++sym) {
     u[sym].setZero(nh, nb_);
     for (int o = 0; o < nb_; ++o) {
-      const Eigen::Map<const Eigen::MatrixXd> k(ops_[4 * o + sym].data(), nh, nh);
-      // targets t = s + o: K_o
+      const std::size_t blk = 4 * static_cast<std::size_t>(o) + sym;
+      const int r = rank_[blk];
+      const double *data = ops_[blk].data();
+      // targets t = s + o: K_o; targets t = s - o: K_{-o} = K_o^T
       const int up = std::min(src_hi, nb_ - o) - src_lo;
-      if (up > 0) u[sym].middleCols(src_lo + o, up).noalias() += k * v[sym].middleCols(src_lo, up);
-      // targets t = s - o: K_{-o} = K_o^T
       const int s0 = std::max(src_lo, o);
-      if (o > 0 && src_hi > s0) u[sym].middleCols(s0 - o, src_hi - s0).noalias() += k.transpose() * v[sym].middleCols(s0, src_hi - s0);
+      const bool down = o > 0 && src_hi > s0;
+      if (r == nh) {
+        const Eigen::Map<const Eigen::MatrixXd> k(data, nh, nh);
+        if (up > 0) u[sym].middleCols(src_lo + o, up).noalias() += k * v[sym].middleCols(src_lo, up);
+        if (down) u[sym].middleCols(s0 - o, src_hi - s0).noalias() += k.transpose() * v[sym].middleCols(s0, src_hi - s0);
+      } else {
+        // compressed: K_o = U W
+        const Eigen::Map<const Eigen::MatrixXd> uf(data, nh, r), wf(data + static_cast<std::size_t>(nh) * r, r, nh);
+        if (up > 0) {
+          tmp.noalias() = wf * v[sym].middleCols(src_lo, up);
+          u[sym].middleCols(src_lo + o, up).noalias() += uf * tmp;
+        }
+        if (down) {
+          tmp.noalias() = uf.transpose() * v[sym].middleCols(s0, src_hi - s0);
+          u[sym].middleCols(s0 - o, src_hi - s0).noalias() += wf.transpose() * tmp;
+        }
+      }
     }
   }
   from_sym(pxy_, pz_, u, phi);

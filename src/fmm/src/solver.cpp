@@ -62,6 +62,15 @@ void Solver::set_box(double xlo, double ylo, double lx, double ly) {
   impl_->built = false;
 }
 
+void Solver::set_z_range(double zlo, double zhi) {
+  if (impl_->opts.boundary != Boundary::Periodic2D)
+    throw std::invalid_argument("gcfmm: set_z_range() is only for Boundary::Periodic2D");
+  if (!(std::isfinite(zlo) && std::isfinite(zhi)) || !(zhi >= zlo))
+    throw std::invalid_argument("gcfmm: set_z_range() needs finite zlo <= zhi");
+  impl_->zhint_lo = zlo;
+  impl_->zhint_hi = zhi;
+}
+
 void Solver::build(std::size_t n, const double *x, const double *y, const double *z) {
   Impl &I = *impl_;
   if (I.periodic() && !I.box_set) throw std::runtime_error("gcfmm: Periodic2D needs set_box() before build()");

@@ -163,8 +163,13 @@ void Solver::Impl::setup_far_field() {
   if (!periodic() || opts.farfield != FarField::Exact) return;
   // the lattice sum accepts accuracies down to 1e-8 (its far field is smooth and tiny anyway)
   const double facc = std::max(opts.accuracy, 1e-8);
-  if (far.needs_setup(sx0, sy0, slx, sly, zmin, zmax, opts.images, facc))
-    far.setup(sx0, sy0, slx, sly, zmin, zmax, opts.images, facc);
+  double lo = zmin, hi = zmax;
+  if (!std::isnan(zhint_lo)) {
+    lo = std::min(lo, zhint_lo * inv_h);
+    hi = std::max(hi, zhint_hi * inv_h);
+  }
+  if (far.needs_setup(sx0, sy0, slx, sly, lo, hi, opts.images, facc))
+    far.setup(sx0, sy0, slx, sly, lo, hi, opts.images, facc);
   stats.estimated_error += far.estimated_error();
 }
 

@@ -106,6 +106,7 @@ struct Solver::Impl {
   std::vector<double> leaf_prefix;            // cumulative estimated cost over leaves
   std::vector<std::pair<std::uint32_t, std::uint32_t>> coincident;  // sorted indices, closer than kCoincidenceRadius h
   double zmin = 0.0, zmax = 0.0;              // z range of all particles (units of h)
+  double zhint_lo = NAN, zhint_hi = NAN;      // set_z_range(): range the far field covers
   PeriodicFarField far;
 
   bool periodic() const { return opts.boundary == Boundary::Periodic2D; }

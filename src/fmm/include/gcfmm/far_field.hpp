@@ -46,6 +46,11 @@ class PeriodicFarField {
   //! are not limited (the column is split into boxes; H / L = 50 is tested).
   static constexpr double kMaxAspect = 2.0;
 
+  //! setup() truncates each operator block's SVD at this times the accuracy, relative to its
+  //! largest singular value: a block's error then adds at most ~1e-6 x accuracy x (offset in
+  //! boxes) of the sheet field (doc/theory.md, after eq. (4.6))
+  static constexpr double kCompressionPerAccuracy = 1e-6;
+
   /**
    * @brief Precompute the operator.
    * @param x0,y0,lx,ly primary cell [x0,x0+lx) x [y0,y0+ly)
@@ -107,6 +112,8 @@ class PeriodicFarField {
                    std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
                    double *ez) const;
   double sample_error() const;
+  // replace each block by its truncated SVD (U, W = S V^T) where that halves the work
+  void compress(double rel_tol);
 
   double x0_ = 0, y0_ = 0, lx_ = 0, ly_ = 0;  //!< primary cell
   double zlo_ = 0, zhi_ = 0;                  //!< stored (padded) z range
@@ -116,7 +123,9 @@ class PeriodicFarField {
   double hz_ = 0;                             //!< box height
   double est_error_ = 0;                      //!< sampled relative kernel error
   double setup_s_ = 0;                        //!< set-up wall time
-  std::vector<std::vector<double>> ops_;      //!< blocks K_{o,s} (column-major) at 4 o + s, o = 0 .. nb-1
+  std::vector<std::vector<double>> ops_;      //!< blocks K_{o,s} (column-major) at 4 o + s, o = 0 .. nb-1,
+                                              //!< or U (nh x r) then W (r x nh) where rank_ < nh
+  std::vector<int> rank_;                     //!< rank of each stored block (nh: dense)
   std::vector<double> tab_xy_, tab_z_;        //!< T_k(t_i) at the Chebyshev nodes
 };
 

@@ -68,6 +68,11 @@ class Solver {
   /** @brief Periodic2D only: the primary cell [xlo, xlo+lx) x [ylo, ylo+ly). */
   void set_box(double xlo, double ylo, double lx, double ly);
 
+  /** @brief Periodic2D with FarField::Exact: the far-field operator covers at least
+   *  [zlo, zhi] (e.g. the simulation box), so that it is set up once instead of again each
+   *  time the particles' z range grows (its set-up costs far more than an evaluation). */
+  void set_z_range(double zlo, double zhi);
+
   /** @brief Build the tree and interaction lists for n particles. Positions of a periodic
    *  system may lie outside the primary cell: x and y are wrapped into it internally.
    *  Charges are not needed. */
