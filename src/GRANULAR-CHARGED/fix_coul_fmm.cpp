@@ -36,6 +36,10 @@
 using namespace LAMMPS_NS;
 using namespace FixConst;
 
+// per atom incl. ghosts for the near refresh (near_delta columns): displacement since the last
+// evaluation, since the two evaluations of the slope, and whether the slope covers the atom
+enum : int { DELTA_E = 0, DELTA_A = 3, DELTA_B = 6, DELTA_IN_SLOPE = 9, NEAR_COMM = 10 };
+
 // per-atom state of the last evaluation (eval_state columns)
 enum : int {
   EVAL_X = 0,         // unwrapped position at the evaluation (3)
@@ -43,7 +47,10 @@ enum : int {
   EVAL_FIELD = 4,     // evaluated Ex, Ey, Ez, phi (4)
   EVAL_SLOPE = 8,     // change of the far part per step, from the last two evaluations (4)
   EVAL_LAST_X = 12,   // unwrapped position when a field was last applied (3)
-  EVAL_COLS = 15
+  EVAL_SLOPE_A = 15,  // unwrapped positions at the two evaluations the slope was taken over
+  EVAL_SLOPE_B = 18,  // (3 each): the trend of a pair inside the slope, for the near refresh
+  EVAL_IN_SLOPE = 21, // 1 if the slope covers this atom's pairs (it existed at both evaluations)
+  EVAL_COLS = 22
 };
 
 /* ---------------------------------------------------------------------- */
@@ -55,7 +62,7 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
     energy_all(0.0), energy_summed(false), field(nullptr), eval_state(nullptr),
     near_delta(nullptr), nmax_ghost(0), list(nullptr), check_every(0), fresh(nullptr),
     nmax_check(0), check_last(0.0), check_max(0.0), check_num(0.0), check_den(0.0),
-    near_now(nullptr), nmax_near(0),
+    near_now(nullptr), near_then(nullptr), nmax_near(0), slope_steps(0.0),
     logged(false)
 {
   scalar_flag = 1;
@@ -75,7 +82,7 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
   create_attribute = 1;    // atoms created by other fixes get a zero stored field (set_arrays)
   restart_global = 1;      // the evaluation schedule and the stored field survive a restart
   restart_peratom = 1;
-  comm_forward = 3;        // displacements since the last evaluation, for the near refresh
+  comm_forward = NEAR_COMM;    // displacements since the evaluations, for the near refresh
 
   opts->accuracy = 1e-4;
   opts->images = 1;
@@ -208,6 +215,7 @@ FixCoulFMM::~FixCoulFMM()
   memory->destroy(near_delta);
   memory->destroy(fresh);
   memory->destroy(near_now);
+  memory->destroy(near_then);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -547,21 +555,38 @@ void FixCoulFMM::compute_field(bool with_slope)
   const bigint step = update->ntimestep;
   const Continuity cont = (with_slope && every > 1) ? field_continuity() : Continuity::NONE;
   const bool same = cont == Continuity::SAME;
+  const bool keep_slope = cont != Continuity::NONE && extrapolate;
   const double steps = same ? (double) (step - last_computed) : 0.0;
   const bool new_slope = same && extrapolate && step - last_computed >= stride;
-  if (same && near_cutoff > 0.0) near_pair_difference(near_now);
+  const bool near = same && near_cutoff > 0.0;
+  // the refresh the time stepping would have applied now, and D for the new slope
+  if (near) grow_near_buffers();
+  if (near) near_pair_difference(near_now, keep_slope ? trend_factor(steps) : 0.0);
+  if (near && new_slope) near_pair_difference(near_then, -1.0);
   for (int i = 0; i < nlocal; i++) {
     double *st = eval_state[i];
-    const bool keep_slope = cont != Continuity::NONE && extrapolate;
     for (int k = 0; k < 4; k++) {
       // the field the time stepping would have applied now (overwritten below)
       field[i][k] = st[EVAL_FIELD + k] + (keep_slope ? steps * st[EVAL_SLOPE + k] : 0.0) +
-          (same && near_cutoff > 0.0 ? near_now[i][k] : 0.0);
-      if (!keep_slope) st[EVAL_SLOPE + k] = 0.0;
+          (near ? near_now[i][k] : 0.0);
+      if (new_slope) st[EVAL_SLOPE + k] = st[EVAL_FIELD + k] + (near ? near_then[i][k] : 0.0);
+      else if (!keep_slope) st[EVAL_SLOPE + k] = 0.0;
     }
-    domain->unmap(atom->x[i], atom->image[i], &st[EVAL_X]);
+    double xu[3];
+    domain->unmap(atom->x[i], atom->image[i], xu);
+    if (new_slope) {
+      // the slope is taken over t_e -> now: remember both ends for the near refresh
+      for (int k = 0; k < 3; k++) {
+        st[EVAL_SLOPE_A + k] = st[EVAL_X + k];
+        st[EVAL_SLOPE_B + k] = xu[k];
+      }
+    }
+    if (!keep_slope) st[EVAL_IN_SLOPE] = 0.0;
+    for (int k = 0; k < 3; k++) st[EVAL_X + k] = xu[k];
     st[EVAL_Q] = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
+    if (new_slope) st[EVAL_IN_SLOPE] = st[EVAL_Q] != 0.0 ? 1.0 : 0.0;
   }
+  if (new_slope) slope_steps = steps;
   box_computed[0] = domain->boxlo[0];
   box_computed[1] = domain->boxlo[1];
   box_computed[2] = domain->xprd;
@@ -579,10 +604,8 @@ void FixCoulFMM::compute_field(bool with_slope)
         sums[0] += q2 * (predicted - st[EVAL_FIELD + k]) * (predicted - st[EVAL_FIELD + k]);
         sums[1] += q2 * st[EVAL_FIELD + k] * st[EVAL_FIELD + k];
       }
-      // E(t_p) + D = predicted - steps S_old
-      if (new_slope)
-        st[EVAL_SLOPE + k] =
-            (st[EVAL_FIELD + k] - (predicted - steps * st[EVAL_SLOPE + k])) / steps;
+      // S = (E(t) - E(t_e) - D) / (t - t_e); E(t_e) + D was put into the slope columns
+      if (new_slope) st[EVAL_SLOPE + k] = (st[EVAL_FIELD + k] - st[EVAL_SLOPE + k]) / steps;
       field[i][k] = st[EVAL_FIELD + k];
     }
   }
@@ -591,6 +614,23 @@ void FixCoulFMM::compute_field(bool with_slope)
     MPI_Allreduce(sums, all, 2, MPI_DOUBLE, MPI_SUM, world);
     adapt_stride(all[1] > 0.0 ? sqrt(all[0] / all[1]) : 0.0);
   }
+}
+
+void FixCoulFMM::grow_near_buffers()
+{
+  if (atom->nmax <= nmax_near) return;
+  nmax_near = atom->nmax;
+  memory->destroy(near_now);
+  memory->destroy(near_then);
+  memory->create(near_now, nmax_near, 4, "coul/fmm:near_now");
+  memory->create(near_then, nmax_near, 4, "coul/fmm:near_then");
+}
+
+// steps since the last evaluation over the steps the slope was taken over: the share of a
+// pair's trend that the extrapolation has added by now
+double FixCoulFMM::trend_factor(double steps) const
+{
+  return extrapolate && slope_steps > 0.0 ? steps / slope_steps : 0.0;
 }
 
 /* ----------------------------------------------------------------------
@@ -718,7 +758,10 @@ void FixCoulFMM::evaluate_into(double **out, int col)
 void FixCoulFMM::advance_field()
 {
   const double steps = (double) (update->ntimestep - last_computed);
-  if (near_cutoff > 0.0) near_pair_difference(near_now);
+  if (near_cutoff > 0.0) {
+    grow_near_buffers();
+    near_pair_difference(near_now, trend_factor(steps));
+  }
   for (int i = 0; i < atom->nlocal; i++)
     for (int k = 0; k < 4; k++)
       field[i][k] = eval_state[i][EVAL_FIELD + k] +
@@ -727,28 +770,31 @@ void FixCoulFMM::advance_field()
 }
 
 /* ----------------------------------------------------------------------
-   out[i] = C sum_{j: |r_ij(t)| < rc} q_j [(K, 1/r)(r_ij(t)) - (K, 1/r)(r_ij(t_e))] for the
-   local atoms, t_e the last evaluation
+   out[i] = C sum_j q_j [(K, 1/r)(r_ij(t)) - (K, 1/r)(r_ij(t_e))] for the local atoms, t_e the
+   last evaluation, over the pairs closer than rc now (trend < 0: the D of a new slope) or now
+   or at t_e (trend >= 0: the refresh between evaluations); with trend > 0, minus trend times
+   the change over the slope's interval t_A -> t_B of the pairs beyond rc at t_B, whose trend
+   the slope carries (doc/theory.md, eq. (5.3))
 ------------------------------------------------------------------------- */
 
-void FixCoulFMM::near_pair_difference(double **&out)
+void FixCoulFMM::near_pair_difference(double **out, double trend)
 {
   const int nlocal = atom->nlocal, nall = nlocal + atom->nghost;
-  if (atom->nmax > nmax_near) {
-    nmax_near = atom->nmax;
-    memory->destroy(out);
-    memory->create(out, nmax_near, 4, "coul/fmm:near_now");
-  }
   if (nall > nmax_ghost) {
     nmax_ghost = atom->nmax;
     memory->destroy(near_delta);
-    memory->create(near_delta, nmax_ghost, 3, "coul/fmm:near_delta");
+    memory->create(near_delta, nmax_ghost, NEAR_COMM, "coul/fmm:near_delta");
   }
   double **x = atom->x;
   double xu[3];
   for (int i = 0; i < nlocal; i++) {
     domain->unmap(x[i], atom->image[i], xu);
-    for (int k = 0; k < 3; k++) near_delta[i][k] = xu[k] - eval_state[i][EVAL_X + k];
+    for (int k = 0; k < 3; k++) {
+      near_delta[i][DELTA_E + k] = xu[k] - eval_state[i][EVAL_X + k];
+      near_delta[i][DELTA_A + k] = xu[k] - eval_state[i][EVAL_SLOPE_A + k];
+      near_delta[i][DELTA_B + k] = xu[k] - eval_state[i][EVAL_SLOPE_B + k];
+    }
+    near_delta[i][DELTA_IN_SLOPE] = eval_state[i][EVAL_IN_SLOPE];
   }
   comm->forward_comm(this);
 
@@ -765,21 +811,40 @@ void FixCoulFMM::near_pair_difference(double **&out)
     for (int jj = 0; jj < list->numneigh[i]; jj++) {
       const int j = jlist[jj] & NEIGHMASK;
       if (!(mask[j] & groupbit) || q[j] == 0.0) continue;
+      const double *di = near_delta[i], *dj = near_delta[j];
       double now[3], then[3];
       for (int k = 0; k < 3; k++) {
         now[k] = x[i][k] - x[j][k];
-        then[k] = now[k] - (near_delta[i][k] - near_delta[j][k]);
+        then[k] = now[k] - (di[DELTA_E + k] - dj[DELTA_E + k]);
       }
-      // the refreshed pairs are those now closer than the cutoff: a set that depends on the
-      // positions only (not on when the list was built), so split runs agree
+      // refreshed: the pairs now closer than the cutoff and, between evaluations (trend >= 0),
+      // also those that were at the last evaluation (their change is in no slope). The sets
+      // depend on positions only (not on when the list was built), so split runs agree.
       const double rn2 = now[0] * now[0] + now[1] * now[1] + now[2] * now[2];
-      if (rn2 >= near_cutsq) continue;
-      const double rn = sqrt(rn2);
-      const double rt = sqrt(then[0] * then[0] + then[1] * then[1] + then[2] * then[2]);
-      if (rn == 0.0 || rt == 0.0) continue;    // coincident atoms are caught at evaluations
+      const double rt2 = then[0] * then[0] + then[1] * then[1] + then[2] * then[2];
+      if (rn2 >= near_cutsq && (trend < 0.0 || rt2 >= near_cutsq)) continue;
+      if (rn2 == 0.0 || rt2 == 0.0) continue;    // coincident atoms are caught at evaluations
+      const double rn = sqrt(rn2), rt = sqrt(rt2);
       const double sn = q[j] / (rn * rn * rn), st = q[j] / (rt * rt * rt);
       for (int k = 0; k < 3; k++) e[k] += sn * now[k] - st * then[k];
       e[3] += q[j] / rn - q[j] / rt;
+      // a pair that was beyond the cutoff at the later evaluation of the slope has its trend
+      // in the slope: take it out, the pair is summed exactly (doc/theory.md, eq. (5.3))
+      if (trend > 0.0 && di[DELTA_IN_SLOPE] != 0.0 && dj[DELTA_IN_SLOPE] != 0.0) {
+        double rb[3], ra[3];
+        for (int k = 0; k < 3; k++) {
+          rb[k] = now[k] - (di[DELTA_B + k] - dj[DELTA_B + k]);
+          ra[k] = now[k] - (di[DELTA_A + k] - dj[DELTA_A + k]);
+        }
+        const double rb2 = rb[0] * rb[0] + rb[1] * rb[1] + rb[2] * rb[2];
+        const double ra2 = ra[0] * ra[0] + ra[1] * ra[1] + ra[2] * ra[2];
+        if (rb2 >= near_cutsq && ra2 > 0.0) {
+          const double b = sqrt(rb2), a = sqrt(ra2);
+          const double sb = trend * q[j] / (b * b * b), sa = trend * q[j] / (a * a * a);
+          for (int k = 0; k < 3; k++) e[k] -= sb * rb[k] - sa * ra[k];
+          e[3] -= trend * (q[j] / b - q[j] / a);
+        }
+      }
     }
     for (int k = 0; k < 4; k++) out[i][k] = c * e[k];
   }
@@ -901,7 +966,8 @@ double FixCoulFMM::compute_vector(int n)
 
 double FixCoulFMM::memory_usage()
 {
-  double bytes = (4.0 + EVAL_COLS) * atom->nmax * sizeof(double) + 3.0 * nmax_ghost * sizeof(double);
+  double bytes = (4.0 + EVAL_COLS) * atom->nmax * sizeof(double) +
+      (double) NEAR_COMM * nmax_ghost * sizeof(double) + 8.0 * nmax_near * sizeof(double);
   bytes += (double) (gx.capacity() * 14) * sizeof(double);    // gathered atoms and results
   return bytes;
 }
@@ -947,7 +1013,7 @@ int FixCoulFMM::pack_forward_comm(int n, int *list_send, double *buf_out, int /*
 {
   int m = 0;
   for (int i = 0; i < n; i++)
-    for (int k = 0; k < 3; k++) buf_out[m++] = near_delta[list_send[i]][k];
+    for (int k = 0; k < NEAR_COMM; k++) buf_out[m++] = near_delta[list_send[i]][k];
   return m;
 }
 
@@ -955,7 +1021,7 @@ void FixCoulFMM::unpack_forward_comm(int n, int first, double *buf_in)
 {
   int m = 0;
   for (int i = first; i < first + n; i++)
-    for (int k = 0; k < 3; k++) near_delta[i][k] = buf_in[m++];
+    for (int k = 0; k < NEAR_COMM; k++) near_delta[i][k] = buf_in[m++];
 }
 
 /* ----------------------------------------------------------------------
@@ -966,12 +1032,13 @@ void FixCoulFMM::unpack_forward_comm(int n, int first, double *buf_in)
 void FixCoulFMM::write_restart(FILE *fp)
 {
   if (comm->me == 0) {
-    double list_out[9] = {(double) last_computed, (double) natoms_computed, box_computed[0],
-                          box_computed[1],        box_computed[2],          box_computed[3],
-                          (double) every,         tolerance,                (double) stride};
+    double list_out[10] = {(double) last_computed, (double) natoms_computed, box_computed[0],
+                           box_computed[1],        box_computed[2],          box_computed[3],
+                           (double) every,         tolerance,                (double) stride,
+                           slope_steps};
     int size = sizeof(list_out);
     fwrite(&size, sizeof(int), 1, fp);
-    fwrite(list_out, sizeof(double), 9, fp);
+    fwrite(list_out, sizeof(double), 10, fp);
   }
 }
 
@@ -981,6 +1048,7 @@ void FixCoulFMM::restart(char *buf)
   // a different every or tolerance gives a different schedule: evaluate afresh
   if ((int) list_in[6] != every || list_in[7] != tolerance) return;
   stride = (int) list_in[8];
+  slope_steps = list_in[9];
   last_computed = (bigint) list_in[0];
   natoms_computed = (bigint) list_in[1];
   for (int k = 0; k < 4; k++) box_computed[k] = list_in[2 + k];

@@ -89,7 +89,9 @@ class FixCoulFMM : public Fix {
   double check_last, check_max;        // measured MTS errors
   double check_num, check_den;         // their sums of squares over all checks
   double **near_now;                   // near-pair difference of the field (refresh)
+  double **near_then;                  // the same over the pairs closer now only (slope)
   int nmax_near;
+  double slope_steps;                  // steps between the two evaluations of the slope
   bool logged;
 
   // gathered charged atoms of the group, sorted by atom ID (identical on every rank)
@@ -109,7 +111,9 @@ class FixCoulFMM : public Fix {
   Continuity field_continuity();
   void compute_field(bool with_slope);
   void adapt_stride(double error);
-  void near_pair_difference(double **&out);
+  void near_pair_difference(double **out, double trend);
+  void grow_near_buffers();
+  double trend_factor(double steps) const;
   void advance_field();
   void remember_positions();
   void evaluate_into(double **out, int col);
