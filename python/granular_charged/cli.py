@@ -25,6 +25,15 @@ the tables (summary.csv, runs.csv, table2/table2.csv) and the figures (figures/*
 Finished runs are reused: an interrupted demo resumes."""
 
 
+REPRODUCE_DESCRIPTION = """The paper's scaling claims tested in this model, resumable:
+the charge series q = 0, 100, 200, 260, 300, 400, 450 e0 at the Fig. 2 case (phi_0/phi - 1 vs
+q: log-log slope with a bootstrap uncertainty over the seeds; the paper: 2), neutral cases at
+U_0 = 0.5, 0.707, 1.414, 2 m/s, gamma = 5, 20 mJ/m^2 and r_p = 1 um (phi and <Z> vs Ad*, the
+collapse of the charged cases quantified; the paper's Fig. 9), and the Table 2 check. N = 500
+in L = 14 r_p, or with --quick N = 200 in L = 9 r_p (the paper's particles per floor area),
+three seeds, one particle per r_p of fall (doc/deposition.md)."""
+
+
 def _common() -> argparse.ArgumentParser:
     """Options every subcommand takes (before or after its name)."""
     p = argparse.ArgumentParser(add_help=False)
@@ -99,15 +108,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--table2", default=None, metavar="DIR",
                    help="a folder of charged-after-formation runs (demo-output/table2)")
 
-    for name, hlp in (("demo", "the reduced Fig. 2 study: runs, table, Table 2, figures"),
-                      ("reproduce", "the paper's checks this package has, and its claims not "
-                                    "yet covered")):
-        p = sub.add_parser(name, parents=[common], help=hlp,
-                           description=(DEMO_DESCRIPTION if name == "demo" else
-                                        "Runs the checks the package has for the paper's "
-                                        "claims (the Table 2 'charged after formation' check "
-                                        "and phi vs q, at the demo's reduced size) and lists "
-                                        "the claims with what is and is not covered."),
+    p = sub.add_parser("reproduce", parents=[common],
+                       help="the paper's scaling claims at reduced size: q^2 law, Ad* collapse, "
+                            "Table 2 (--quick: under 15 min)",
+                       description=REPRODUCE_DESCRIPTION,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--out", default="reproduce-output", help="output folder (default "
+                   "reproduce-output)")
+    p.add_argument("--quick", action="store_true",
+                   help="N = 200 in L = 9 r_p instead of N = 500 in L = 14 r_p")
+    p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3],
+                   help="seeds of the injection positions (default 1 2 3)")
+    p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
+                   help="deck variables for every run (e.g. --var theta_crit 0.04)")
+    p.add_argument("--jobs", type=int, default=1, help="runs at a time")
+    p.add_argument("--np", type=int, default=1, help="MPI ranks per run")
+    p.add_argument("--no-render", action="store_true", help="no rendered packing images")
+
+    for name, hlp in (("demo", "the reduced Fig. 2 study: runs, table, Table 2, figures"),):
+        p = sub.add_parser(name, parents=[common], help=hlp, description=DEMO_DESCRIPTION,
                            formatter_class=argparse.RawDescriptionHelpFormatter)
         p.add_argument("--out", default=f"{name}-output", help=f"output folder (default {name}-output)")
         p.add_argument("--N", type=int, default=500, help="particles per run (default 500)")
@@ -124,6 +143,8 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--no-render", action="store_true", help="no rendered packing images")
         p.add_argument("--tracer", type=int, default=None,
                        help="particle id to follow in the first seed's runs (default N/2)")
+        p.add_argument("--claims", action="store_true",
+                       help="then list the paper's claims with what this package checks of each")
     return ap
 
 
@@ -212,6 +233,16 @@ def cmd_figures(a) -> int:
     return 0
 
 
+def cmd_reproduce(a) -> int:
+    from .reproduce import Reproduction, report
+    runner = _runner(a, not a.no_render)
+    study = Reproduction(out=Path(a.out), quick=a.quick, seeds=tuple(a.seeds),
+                         extra={k: v for k, v in a.var}, jobs=a.jobs, progress=a.progress)
+    res = study.run(runner)
+    print(report(res, study))
+    return 0 if res["complete"] else 1
+
+
 def cmd_demo(a, reproduce=False) -> int:
     from .demo import DEMO_VARS, Study, claims_report, report
     runner = _runner(a, not a.no_render)
@@ -241,7 +272,9 @@ def main(argv=None) -> int:
             return cmd_sweep(a)
         if a.command == "figures":
             return cmd_figures(a)
-        return cmd_demo(a, reproduce=a.command == "reproduce")
+        if a.command == "reproduce":
+            return cmd_reproduce(a)
+        return cmd_demo(a, reproduce=a.claims)
     except BuildError as e:
         log.error("%s", e)
         return 2

@@ -45,7 +45,8 @@ CLAIMS = (
     ("Fig. 3: phi decreases with q (phi_0 = 0.270-0.363 for the neutral packings)",
      "checked at reduced size: phi vs q (phi_vs_q.png)"),
     ("Fig. 3: phi_0/phi - 1 grows as q^2 (slope 2 in log-log), up to 40 %",
-     "checked at reduced size: fitted slope in expansion_loglog.png (few charges: coarse)"),
+     "checked at reduced size: `granular-charged reproduce` fits the slope over 6 charges with "
+     "a bootstrap uncertainty over the seeds (expansion_fit.json)"),
     ("Fig. 2: looser, chain-like packings with lower Z when charged",
      "shown: rendered packings coloured by Z (packing_*.png), f(Z) (fZ.png)"),
     ("Fig. 6/7: force network and narrow, nearly symmetric force pdf |F_n/F_C| < 0.1, shifted "
@@ -54,7 +55,7 @@ CLAIMS = (
     ("Fig. 8: the Coulomb field decelerates an incident particle before contact",
      "shown: tracer_energy.png"),
     ("Fig. 9: phi and <Z> collapse on Ad* = gamma / (rho U0^2 (1 - E*) r_p) for Ad* > 1",
-     "NOT covered: needs the r_p, U_0, gamma series (sweep --preset paper; hours)"),
+     "checked at reduced size by `granular-charged reproduce` (collapse.csv, phi_Z_vs_Adstar.png)"),
     ("Fig. 10: states on the Edwards-ensemble phase diagram phi(Z) towards ALP (Z = 2, phi = 1/8)",
      "NOT covered: the g_2(r, Z) model of Liu et al. 2015 (Eqs. 9-10) is not implemented; the "
      "ALP point is drawn beside our points only"),

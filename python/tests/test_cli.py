@@ -23,7 +23,7 @@ def test_help_lists_the_five_subcommands(cli, tmp_path):
 
 
 @pytest.mark.parametrize("cmd,opt", [("run", "--seed"), ("sweep", "--seeds"), ("figures", "--table2"),
-                                     ("demo", "--table2-q"), ("reproduce", "--tracer")])
+                                     ("demo", "--table2-q"), ("reproduce", "--quick")])
 def test_each_subcommand_has_help(cli, tmp_path, cmd, opt):
     r = cli([cmd, "--help"], cwd=tmp_path)
     assert f"usage: granular-charged {cmd}" in r.stdout and opt in r.stdout

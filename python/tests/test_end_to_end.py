@@ -1,4 +1,4 @@
-"""End to end through the command line: `granular-charged reproduce` at a tiny size, interrupted
+"""End to end through the command line: `granular-charged demo --claims` at a tiny size, interrupted
 during its second run and started again (resumption), then its JSON results, tables, Table 2
 check, figures and rendered packings.
 
@@ -36,8 +36,8 @@ from granular_charged.params import jkr_scales, pair_modulus
 N, TRACER = 40, 30
 Q = 480.0
 SMALL = ["--var", "L_rp", "6", "--var", "H_rp", "60", "--var", "gap_rp", "1"]
-ARGS = ["reproduce", "--N", N, "--q", 0, Q, "--seeds", 1, "--table2-q", 0, 400, "--tracer", TRACER,
-        *SMALL]
+ARGS = ["demo", "--claims", "--N", N, "--q", 0, Q, "--seeds", 1, "--table2-q", 0, 400, "--tracer",
+        TRACER, *SMALL]
 
 
 def _env(build_dir):

@@ -1,0 +1,126 @@
+"""`granular-charged reproduce`: the paper's scaling claims tested in this model, with seeds.
+
+Runs (resumable, in parallel with --jobs), at the demo's reduced size (N = 500 in L = 14 r_p,
+the paper's particles per floor area) or, with --quick, N = 200 in L = 9 r_p:
+
+- the charge series of the paper's Fig. 2 case (r_p = 2 um, U_0 = 1 m/s, gamma = 10 mJ/m^2)
+  at q = 0, 100, 200, 260, 300, 400, 450 e_0 (E* up to 0.75): phi_0/phi - 1 vs q on log-log,
+  the fitted slope with its bootstrap uncertainty over the seeds (the paper: slope 2);
+- neutral cases at other Ad = gamma / (rho U_0^2 r_p): U_0 = 0.5, 0.707, 1.414, 2 m/s,
+  gamma = 5, 20 mJ/m^2, r_p = 1 um: phi and <Z> vs Ad* with the charged cases on the same
+  axes, the collapse quantified (tables.adstar_collapse; the paper's Fig. 9);
+- the Table 2 check (charging a formed neutral packing).
+
+Every case has the same seeds (default 1, 2, 3). The numbers of doc/reproduction.md come from
+this command; the paper-size rows from `sweep --N 2000`.
+"""
+from __future__ import annotations
+
+import json
+import logging
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from . import figures, paper, tables
+from .after_formation import run_table2
+from .params import DepositionParams
+from .runner import RunError, Runner
+from .sweep import Sweep
+
+log = logging.getLogger(__name__)
+
+CHARGES = (0.0, 100.0, 200.0, 260.0, 300.0, 400.0, 450.0)
+# neutral cases that move Ad away from the Fig. 2 case's 2, each by one parameter
+NEUTRAL_CASES = ({"U0": 0.5}, {"U0": 0.707}, {"U0": 1.414}, {"U0": 2.0},
+                 {"gamma": 0.005}, {"gamma": 0.02}, {"rp": 1.0e-6})
+SIZES = {"full": {"N": 500, "L_rp": 14}, "quick": {"N": 200, "L_rp": 9}}
+
+
+@dataclass
+class Reproduction:
+    out: Path
+    quick: bool = False
+    seeds: tuple = (1, 2, 3)
+    charges: tuple = CHARGES
+    table2_qs: tuple = (0.0, 260.0, 400.0)
+    extra: dict = field(default_factory=dict)    # deck variables for every run
+    jobs: int = 1
+    progress: bool = True
+
+    @property
+    def size(self) -> dict:
+        return SIZES["quick" if self.quick else "full"]
+
+    def params(self, have_fmm: bool) -> list[DepositionParams]:
+        extra = {"L_rp": self.size["L_rp"], "gap_rp": 1, **self.extra}
+        N = self.size["N"]
+        ps = [DepositionParams(q=q, N=N, seed=s, extra=dict(extra))
+              for q in self.charges if have_fmm or q == 0 for s in self.seeds]
+        ps += [DepositionParams(N=N, seed=s, extra=dict(extra), **case)
+               for case in NEUTRAL_CASES for s in self.seeds]
+        return ps
+
+    def run(self, runner: Runner) -> dict:
+        t0 = time.monotonic()
+        out = Path(self.out).resolve()
+        have_fmm = runner.build.capabilities["coul/fmm"]
+        if not have_fmm:
+            log.warning("fix coul/fmm is NOT in this build: the charged cases are not run")
+        params = self.params(have_fmm)
+        results = Sweep(runner, out / "runs", jobs=self.jobs, progress=self.progress).run(params)
+        runs = tables.runs_frame(results)
+        summ = tables.summary(runs)
+        fit = tables.expansion_fit(runs)
+        collapse = tables.adstar_collapse(runs)
+        runs.drop(columns=["dir"]).to_csv(out / "runs.csv", index=False)
+        summ.to_csv(out / "summary.csv", index=False)
+        collapse.to_csv(out / "collapse.csv", index=False)
+        (out / "expansion_fit.json").write_text(json.dumps(fit, indent=1))
+        t2 = []
+        neutral = sorted((r for r in results if r["params"]["q"] == 0 and
+                          r["params"]["U0"] == 1.0 and r["params"]["gamma"] == 0.01 and
+                          r["params"]["rp"] == 2e-6), key=lambda r: r["params"]["seed"])
+        if neutral and have_fmm and self.table2_qs:
+            try:
+                t2 = run_table2(runner, Path(neutral[0]["dir"]), self.table2_qs, out / "table2")
+            except RunError as e:
+                log.error("Table 2 check FAILED: %s", e)
+        figs = figures.all_figures(results, out / "figures", t2)
+        return {"out": out, "runs": runs, "summary": summ, "fit": fit, "collapse": collapse,
+                "table2": tables.table2_frame(t2) if t2 else None, "figures": figs,
+                "wall_s": time.monotonic() - t0, "complete": len(results) == len(params)}
+
+
+def report(res: dict, study: Reproduction) -> str:
+    s, fit, c = res["summary"], res["fit"], res["collapse"]
+    size = study.size
+    lines = [f"granular-charged reproduce{' --quick' if study.quick else ''}: N = {size['N']} in "
+             f"L = {size['L_rp']} r_p (paper: N = 2000 in L = 28 r_p), seeds "
+             f"{', '.join(map(str, study.seeds))}, one particle per r_p of fall", "",
+             tables.format_table(s[["rp_um", "U0", "gamma_mJ", "q", "runs", "phi", "phi_sd", "Z",
+                                    "Z_sd", "Ad", "Estar", "Adstar", "expansion"]]), ""]
+    if fit.get("points", 0) >= 2:
+        lines.append(f"phi_0/phi - 1 vs q (r_p = 2 um, U_0 = 1 m/s): log-log slope "
+                     f"{fit['slope']:.2f}, bootstrap over seeds {fit['boot_mean']:.2f} +- "
+                     f"{fit['sd']:.2f} (16-84%: {fit['p16']:.2f} .. {fit['p84']:.2f}) from "
+                     f"{fit['points']} charges with a positive expansion (paper: "
+                     f"{paper.EXPANSION_SLOPE:g}); largest expansion "
+                     f"{s['expansion'].max():.3f} (paper: up to {paper.MAX_RELATIVE_DECREASE:g})")
+    if "phi_dev" in c and c["phi_line"].notna().any():
+        ch, ne = c[c["q"] > 0], c[c["q"] == 0]
+        lines.append(
+            "Ad* collapse (Fig. 9): deviation from the neutral cases' line phi(log Ad*), in "
+            "standard errors of the mean: neutral cases RMS "
+            f"{(ne['phi_dev'] ** 2).mean() ** 0.5:.1f}, charged cases RMS "
+            f"{(ch['phi_dev'] ** 2).mean() ** 0.5:.1f}; mean charged phi - line "
+            f"{(ch['phi'] - ch['phi_line']).mean():+.4f}, <Z> - line "
+            f"{(ch['Z'] - ch['Z_line']).mean():+.3f}")
+    if res["table2"] is not None:
+        t = res["table2"]
+        lines.append(f"Table 2: max |phi_after - phi_before| = {t['dphi'].abs().max():.2g}, "
+                     f"max |<Z>_after - <Z>_before| = {t['dZ'].abs().max():.2g} (paper: 2e-4, 0)")
+    lines += ["", f"tables: {res['out']}/summary.csv, runs.csv, collapse.csv, "
+              "expansion_fit.json; figures: " + f"{res['out']}/figures",
+              f"wall time: {res['wall_s']:.0f} s"]
+    return "\n".join(lines)
