@@ -137,7 +137,7 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--table2-q", type=float, nargs="*", default=[0.0, 260.0, 400.0],
                        help="charges of the Table 2 check (none: skip it)")
         p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
-                       help="deck variables besides the demo's L_rp 14, gap_rp 1, coul_every 10")
+                       help="deck variables besides the demo's L_rp 14, gap_rp 1")
         p.add_argument("--jobs", type=int, default=1, help="runs at a time")
         p.add_argument("--np", type=int, default=1, help="MPI ranks per run")
         p.add_argument("--no-render", action="store_true", help="no rendered packing images")
