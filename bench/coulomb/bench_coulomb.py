@@ -94,6 +94,11 @@ def main():
     ap.add_argument("--sizes", type=int, nargs="+", default=[2000, 20000, 200000])
     ap.add_argument("--lmp", default=os.path.join(HERE, "..", "..", "build", "lmp"))
     ap.add_argument("--np", type=int, default=1)
+    ap.add_argument("--fmm-acc", type=float, nargs="+", default=[1e-4, 1e-5],
+                    help="fix coul/fmm accuracy settings")
+    ap.add_argument("--pppm-acc", type=float, nargs="+", default=None,
+                    help="pppm accuracy settings (default 1e-6 1e-7 1e-8; 1e-6 1e-7 above N = 20000)")
+    ap.add_argument("--no-ewald-direct", action="store_true", help="skip ewald and coul/cut")
     args = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="gc-bench-")
     rows = []
@@ -106,15 +111,15 @@ def main():
         # the tests) cross-checked against pppm at its tightest setting
         t_ref, fref = run(args.lmp, args.np, data, "fmm", 1e-8, 2 * RP, 1, out("ref"))
         rows.append((n, "fmm reference 1e-8", "-", t_ref, 0.0))
-        for acc in (1e-4, 1e-5):
+        for acc in args.fmm_acc:
             t, f = run(args.lmp, args.np, data, "fmm", acc, 2 * RP, steps, out(f"fmm{acc}"))
             rows.append((n, f"fmm exact accuracy {acc}", acc, t, rel_rms(f, fref)))
             print(*rows[-1], flush=True)
-        for acc in ((1e-6, 1e-7, 1e-8) if n <= 20000 else (1e-6, 1e-7)):
+        for acc in args.pppm_acc or ((1e-6, 1e-7, 1e-8) if n <= 20000 else (1e-6, 1e-7)):
             t, f = run(args.lmp, args.np, data, "pppm", acc, 5 * RP, steps, out(f"pppm{acc}"))
             rows.append((n, "pppm + slab 3.0", acc, t, rel_rms(f, fref)))
             print(*rows[-1], flush=True)
-        if n <= 20000:
+        if n <= 20000 and not args.no_ewald_direct:
             for acc in ((1e-6, 1e-7) if n <= 2000 else (1e-6,)):
                 t, f = run(args.lmp, args.np, data, "ewald", acc, 5 * RP, 1, out(f"ewald{acc}"))
                 rows.append((n, "ewald + slab 3.0", acc, t, rel_rms(f, fref)))
