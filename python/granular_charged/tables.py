@@ -92,12 +92,19 @@ def expansion_fit(runs: pd.DataFrame, series=(2.0, 1.0, 10.0), n_boot: int = 200
             "paper_slope": paper.EXPANSION_SLOPE}
 
 
-def adstar_collapse(runs: pd.DataFrame) -> pd.DataFrame:
+def adstar_collapse(runs: pd.DataFrame, barrier_fraction: float = 1.0) -> pd.DataFrame:
     """Fig. 9's claim, quantified: a straight line in log10(Ad*) fitted to the neutral cases'
     mean phi (and <Z>); for every case the deviation of its mean from that line, in units of
     the standard error of its mean over the seeds. The charged cases collapse with the neutral
-    ones if their deviations are as small as the neutral cases' own."""
-    s = (runs.groupby(list(CASE), as_index=False)
+    ones if their deviations are as small as the neutral cases' own.
+
+    Ad* = Ad / (1 - f E*): f = 1 is the paper's (the Coulomb barrier of the finished bed);
+    f = 1/2 is the barrier averaged over a deposition, during which the bed's charge, and with
+    it the sheet field an incident particle climbs against, grows from 0 to its final value
+    (doc/reproduction.md, "Ad* collapse")."""
+    r = runs.assign(Adstar=runs["Ad"] / (1.0 - barrier_fraction * runs["Estar"]))
+    r.loc[1.0 - barrier_fraction * runs["Estar"] <= 0.0, "Adstar"] = np.inf
+    s = (r.groupby(list(CASE), as_index=False)
          .agg(runs=("phi", "size"), Adstar=("Adstar", "first"), phi=("phi", "mean"),
               phi_sd=("phi", "std"), Z=("Z", "mean"), Z_sd=("Z", "std")))
     s = s[np.isfinite(s["Adstar"]) & (s["Adstar"] > 0)].copy()
