@@ -285,13 +285,19 @@ void PeriodicFarField::compress(double rel_tol) {
     const Eigen::Map<const Eigen::MatrixXd> m(ops_[k].data(), nh, nh);
     const Eigen::BDCSVD<Eigen::MatrixXd> svd(m, Eigen::ComputeThinU | Eigen::ComputeThinV);
     const auto &sv = svd.singularValues();
+    // Eigen's divide-and-conquer SVD returns NaN for some of these blocks (seen with Eigen
+    // 3.4.0 at L = 14 r_p); such a block, and any whose factors do not reproduce it, stays dense
+    if (!sv.allFinite() || !(sv[0] > 0.0)) continue;
     int r = 0;
     while (r < sv.size() && sv[r] > rel_tol * sv[0]) ++r;
     if (2 * r >= nh) continue;
+    const Eigen::MatrixXd uf = svd.matrixU().leftCols(r);
+    const Eigen::MatrixXd wf = sv.head(r).asDiagonal() * svd.matrixV().leftCols(r).transpose();
+    if (!uf.allFinite() || !wf.allFinite() || !((uf * wf - m).cwiseAbs().maxCoeff() <= 10.0 * rel_tol * sv[0]))
+      continue;
     std::vector<double> packed(2 * static_cast<std::size_t>(nh) * r);
-    Eigen::Map<Eigen::MatrixXd>(packed.data(), nh, r) = svd.matrixU().leftCols(r);
-    Eigen::Map<Eigen::MatrixXd>(packed.data() + static_cast<std::size_t>(nh) * r, r, nh) =
-        sv.head(r).asDiagonal() * svd.matrixV().leftCols(r).transpose();
+    Eigen::Map<Eigen::MatrixXd>(packed.data(), nh, r) = uf;
+    Eigen::Map<Eigen::MatrixXd>(packed.data() + static_cast<std::size_t>(nh) * r, r, nh) = wf;
     ops_[k].swap(packed);
     rank_[k] = r;
   }
