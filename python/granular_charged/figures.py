@@ -495,10 +495,20 @@ def vs_adstar(results, out: Path):
     if not ok:
         return None, None
     df = tables.runs_frame(ok)
+    p1 = _phi_Z_vs(df, "Adstar", "Ad* (paper: all its cases have Ad* > 1)",
+                   Path(out) / "phi_Z_vs_Adstar.png")
+    # the Coulomb barrier averaged over the deposition (doc/reproduction.md, "Ad* collapse")
+    mid = df.assign(Adstar_mid=df["Ad"] / (1.0 - 0.5 * df["Estar"]))
+    _phi_Z_vs(mid, "Adstar_mid", "Ad / (1 - E*/2): the barrier averaged over the deposition",
+              Path(out) / "phi_Z_vs_Adstar_mean_barrier.png")
+    return p1, _phase_diagram(df, out)
+
+
+def _phi_Z_vs(df, col: str, xlabel: str, path: Path):
     fig = new_figure(5.2, 6.0)
     a1, a2 = fig.add_subplot(211), fig.add_subplot(212, sharex=None)
-    sc = a1.scatter(df["Adstar"], df["phi"], c=df["q"], cmap="plasma")
-    a2.scatter(df["Adstar"], df["Z"], c=df["q"], cmap="plasma")
+    sc = a1.scatter(df[col], df["phi"], c=df["q"], cmap="plasma")
+    a2.scatter(df[col], df["Z"], c=df["q"], cmap="plasma")
     a1.axhline(paper.ALP_PHI, **PAPER_STYLE, label="paper: ALP limit phi = 1/8")
     a2.axhline(paper.ALP_Z, **PAPER_STYLE, label="paper: ALP limit <Z> = 2")
     for ax in (a1, a2):
@@ -507,10 +517,12 @@ def vs_adstar(results, out: Path):
         ax.legend(fontsize=6, loc="lower left")
     a1.set_ylabel("phi")
     a2.set_ylabel("<Z>")
-    a2.set_xlabel("Ad* (paper: all its cases have Ad* > 1)")
+    a2.set_xlabel(xlabel)
     fig.colorbar(sc, ax=[a1, a2], label="q / e0")
-    p1 = save(fig, Path(out) / "phi_Z_vs_Adstar.png", df.drop(columns=["dir"]), tight=False)
+    return save(fig, path, df.drop(columns=["dir"]), tight=False)
 
+
+def _phase_diagram(df, out: Path):
     fig = new_figure(5.2, 4.8)
     ax = fig.add_subplot(111)
     sc = ax.scatter(df["Z"], df["phi"], c=df["q"], cmap="plasma", label="this package's runs")
@@ -525,8 +537,7 @@ def vs_adstar(results, out: Path):
     ax.legend(fontsize=7, loc="upper left")
     fig.text(0.01, 0.005, G2_NOTE, fontsize=5.5, va="bottom", wrap=True)
     fig.subplots_adjust(bottom=0.2)
-    p2 = save(fig, Path(out) / "phase_diagram_Z_phi.png", df.drop(columns=["dir"]), tight=False)
-    return p1, p2
+    return save(fig, Path(out) / "phase_diagram_Z_phi.png", df.drop(columns=["dir"]), tight=False)
 
 
 # ---- everything -----------------------------------------------------------------------------
