@@ -5,6 +5,7 @@
 #include "gcfmm/far_field.hpp"
 
 #include <Eigen/Dense>
+#include <Eigen/QR>
 #include <Eigen/SVD>
 
 #include <algorithm>
@@ -277,23 +278,43 @@ void PeriodicFarField::setup_explicit(double x0, double y0, double lx, double ly
 }
 
 void PeriodicFarField::compress(double rel_tol) {
-  // K_{o,s} = U S V^T truncated where sigma_k <= rel_tol sigma_1, stored as U and W = S V^T
-  // when that halves the work (doc/theory.md, after eq. (4.6)); the blocks are smooth kernels between
-  // boxes, so their rank falls fast with the box offset o
+  // K_{o,s} ~ U W, U = Q_r U_s, W = S V^T: a column-pivoted QR K P = Q R truncated where
+  // |R_kk| <= rel_tol ref / 100 (rank-revealing, robust), then the SVD of the small factor
+  // R_r P^T = U_s S V^T truncated where sigma_k <= rel_tol ref (the ranks of an SVD of K,
+  // without its cost). ref = the largest column norm of the four symmetry blocks of the same
+  // offset: a block much smaller than its siblings (odd-odd symmetry far away) is truncated
+  // against the offset's scale, not its own. Stored where that halves the work (doc/theory.md, after eq. (4.6)); the
+  // blocks are smooth kernels between boxes, so their rank falls fast with the box offset o.
+  // (Eigen 3.4's divide-and-conquer SVD of the whole block returned NaN for some of these
+  // blocks and read out of bounds for others.) A block whose factors do not reproduce it to
+  // 10 rel_tol ref stays dense.
   const int nh = pxy_ * pxy_ * pz_ / 4;
+  std::vector<double> ref(nb_, 0.0);
+  for (std::size_t k = 0; k < ops_.size(); ++k)
+    ref[k / 4] = std::max(ref[k / 4],
+                          Eigen::Map<const Eigen::MatrixXd>(ops_[k].data(), nh, nh).colwise().norm().maxCoeff());
   for (std::size_t k = 0; k < ops_.size(); ++k) {
     const Eigen::Map<const Eigen::MatrixXd> m(ops_[k].data(), nh, nh);
-    const Eigen::BDCSVD<Eigen::MatrixXd> svd(m, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    const double scale = ref[k / 4];
+    if (!std::isfinite(scale) || !(scale > 0.0)) continue;
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(m);
+    const Eigen::MatrixXd &packed_qr = qr.matrixQR();
+    int rq = 0;
+    while (rq < nh && std::fabs(packed_qr(rq, rq)) > 0.01 * rel_tol * scale) ++rq;
+    if (4 * rq > 3 * nh) continue;
+    const Eigen::MatrixXd rr = packed_qr.topRows(rq).triangularView<Eigen::Upper>();
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(rr * qr.colsPermutation().transpose(),
+                                                Eigen::ComputeThinU | Eigen::ComputeThinV);
     const auto &sv = svd.singularValues();
-    // Eigen's divide-and-conquer SVD returns NaN for some of these blocks (seen with Eigen
-    // 3.4.0 at L = 14 r_p); such a block, and any whose factors do not reproduce it, stays dense
-    if (!sv.allFinite() || !(sv[0] > 0.0)) continue;
+    if (!sv.allFinite()) continue;
     int r = 0;
-    while (r < sv.size() && sv[r] > rel_tol * sv[0]) ++r;
+    while (r < sv.size() && sv[r] > rel_tol * scale) ++r;
     if (2 * r >= nh) continue;
-    const Eigen::MatrixXd uf = svd.matrixU().leftCols(r);
+    const Eigen::MatrixXd uf =
+        qr.householderQ() * Eigen::MatrixXd::Identity(nh, rq) * svd.matrixU().leftCols(r);
     const Eigen::MatrixXd wf = sv.head(r).asDiagonal() * svd.matrixV().leftCols(r).transpose();
-    if (!uf.allFinite() || !wf.allFinite() || !((uf * wf - m).cwiseAbs().maxCoeff() <= 10.0 * rel_tol * sv[0]))
+    if (!uf.allFinite() || !wf.allFinite() ||
+        !((uf * wf - m).cwiseAbs().maxCoeff() <= 10.0 * rel_tol * scale))
       continue;
     std::vector<double> packed(2 * static_cast<std::size_t>(nh) * r);
     Eigen::Map<Eigen::MatrixXd>(packed.data(), nh, r) = uf;

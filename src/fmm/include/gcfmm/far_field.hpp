@@ -46,9 +46,9 @@ class PeriodicFarField {
   //! are not limited (the column is split into boxes; H / L = 50 is tested).
   static constexpr double kMaxAspect = 2.0;
 
-  //! setup() truncates each operator block's SVD at this times the accuracy, relative to its
-  //! largest singular value: a block's error then adds at most ~1e-6 x accuracy x (offset in
-  //! boxes) of the sheet field (doc/theory.md, after eq. (4.6))
+  //! setup() truncates each operator block's low-rank factorisation at this times the
+  //! accuracy, relative to the scale of the blocks of its offset: a block's error then adds at
+  //! most ~1e-6 x accuracy x (offset in boxes) of the sheet field (doc/theory.md, after eq. (4.6))
   static constexpr double kCompressionPerAccuracy = 1e-6;
 
   /**
@@ -112,7 +112,7 @@ class PeriodicFarField {
                    std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
                    double *ez) const;
   double sample_error() const;
-  // replace each block by its truncated SVD (U, W = S V^T) where that halves the work
+  // replace each block by a truncated low-rank factorisation U W where that halves the work
   void compress(double rel_tol);
 
   double x0_ = 0, y0_ = 0, lx_ = 0, ly_ = 0;  //!< primary cell
