@@ -289,6 +289,9 @@ void PeriodicFarField::compress(double rel_tol) {
   // blocks and read out of bounds for others.) A block whose factors do not reproduce it to
   // 10 rel_tol ref stays dense.
   const int nh = pxy_ * pxy_ * pz_ / 4;
+  // above nh = 256 (accuracy 1e-6 and tighter) the factorisations cost more set-up (seconds per
+  // column) than they save in the few evaluations such runs make: the operator stays dense
+  if (nh > kMaxCompressedBlock) return;
   std::vector<double> ref(nb_, 0.0);
   for (std::size_t k = 0; k < ops_.size(); ++k)
     ref[k / 4] = std::max(ref[k / 4],

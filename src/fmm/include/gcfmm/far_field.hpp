@@ -50,6 +50,8 @@ class PeriodicFarField {
   //! accuracy, relative to the scale of the blocks of its offset: a block's error then adds at
   //! most ~1e-6 x accuracy x (offset in boxes) of the sheet field (doc/theory.md, after eq. (4.6))
   static constexpr double kCompressionPerAccuracy = 1e-6;
+  //! largest block (p^2 pz / 4 rows) that setup() factorises; larger ones stay dense
+  static constexpr int kMaxCompressedBlock = 256;
 
   /**
    * @brief Precompute the operator.
