@@ -113,39 +113,37 @@ def build_parser() -> argparse.ArgumentParser:
                             "Table 2 (--quick: under 15 min)",
                        description=REPRODUCE_DESCRIPTION,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--out", default="reproduce-output", help="output folder (default "
-                   "reproduce-output)")
+    _study_options(p, "reproduce", "deck variables for every run (e.g. --var theta_crit 0.04)")
     p.add_argument("--quick", action="store_true",
                    help="N = 200 in L = 9 r_p instead of N = 500 in L = 14 r_p")
+
+    p = sub.add_parser("demo", parents=[common],
+                       help="the reduced Fig. 2 study: runs, table, Table 2, figures",
+                       description=DEMO_DESCRIPTION,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    _study_options(p, "demo", "deck variables besides the demo's L_rp 14, gap_rp 1")
+    p.add_argument("--N", type=int, default=500, help="particles per run (default 500)")
+    p.add_argument("--q", type=float, nargs="+", default=[0.0, 260.0, 400.0],
+                   help="charges [e0] (default 0 260 400)")
+    p.add_argument("--table2-q", type=float, nargs="*", default=[0.0, 260.0, 400.0],
+                   help="charges of the Table 2 check (none: skip it)")
+    p.add_argument("--tracer", type=int, default=None,
+                   help="particle id to follow in the first seed's runs (default N/2)")
+    p.add_argument("--claims", action="store_true",
+                   help="then list the paper's claims with what this package checks of each")
+    return ap
+
+
+def _study_options(p: argparse.ArgumentParser, name: str, var_help: str):
+    """Options that demo and reproduce share."""
+    p.add_argument("--out", default=f"{name}-output", help=f"output folder (default {name}-output)")
     p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3],
                    help="seeds of the injection positions (default 1 2 3)")
     p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
-                   help="deck variables for every run (e.g. --var theta_crit 0.04)")
+                   help=var_help)
     p.add_argument("--jobs", type=int, default=1, help="runs at a time")
     p.add_argument("--np", type=int, default=1, help="MPI ranks per run")
     p.add_argument("--no-render", action="store_true", help="no rendered packing images")
-
-    for name, hlp in (("demo", "the reduced Fig. 2 study: runs, table, Table 2, figures"),):
-        p = sub.add_parser(name, parents=[common], help=hlp, description=DEMO_DESCRIPTION,
-                           formatter_class=argparse.RawDescriptionHelpFormatter)
-        p.add_argument("--out", default=f"{name}-output", help=f"output folder (default {name}-output)")
-        p.add_argument("--N", type=int, default=500, help="particles per run (default 500)")
-        p.add_argument("--q", type=float, nargs="+", default=[0.0, 260.0, 400.0],
-                       help="charges [e0] (default 0 260 400)")
-        p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3],
-                       help="seeds of the injection positions (default 1 2 3)")
-        p.add_argument("--table2-q", type=float, nargs="*", default=[0.0, 260.0, 400.0],
-                       help="charges of the Table 2 check (none: skip it)")
-        p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
-                       help="deck variables besides the demo's L_rp 14, gap_rp 1")
-        p.add_argument("--jobs", type=int, default=1, help="runs at a time")
-        p.add_argument("--np", type=int, default=1, help="MPI ranks per run")
-        p.add_argument("--no-render", action="store_true", help="no rendered packing images")
-        p.add_argument("--tracer", type=int, default=None,
-                       help="particle id to follow in the first seed's runs (default N/2)")
-        p.add_argument("--claims", action="store_true",
-                       help="then list the paper's claims with what this package checks of each")
-    return ap
 
 
 def setup_logging(verbose: int, quiet: int):
