@@ -115,7 +115,8 @@ def build_parser() -> argparse.ArgumentParser:
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     _study_options(p, "reproduce", "deck variables for every run (e.g. --var theta_crit 0.04)")
     p.add_argument("--quick", action="store_true",
-                   help="N = 200 in L = 9 r_p instead of N = 500 in L = 14 r_p")
+                   help="N = 200 in L = 9 r_p instead of N = 500 in L = 14 r_p, charges 0 200 "
+                        "300 400 450, Table 2 at 400 only")
 
     p = sub.add_parser("demo", parents=[common],
                        help="the reduced Fig. 2 study: runs, table, Table 2, figures",
