@@ -30,7 +30,7 @@ the charge series q = 0, 100, 200, 260, 300, 400, 450 e0 at the Fig. 2 case (phi
 q: log-log slope with a bootstrap uncertainty over the seeds; the paper: 2), neutral cases at
 U_0 = 0.5, 0.707, 1.414, 2 m/s, gamma = 5, 20 mJ/m^2 and r_p = 1 um (phi and <Z> vs Ad*, the
 collapse of the charged cases quantified; the paper's Fig. 9), and the Table 2 check. N = 500
-in L = 14 r_p, or with --quick N = 200 in L = 9 r_p (the paper's particles per floor area),
+in L = 14 r_p, or with --quick N = 200 in L = 9 r_p and five charges (the paper's particles per floor area),
 three seeds, one particle per r_p of fall (doc/deposition.md)."""
 
 
