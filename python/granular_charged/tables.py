@@ -92,6 +92,13 @@ def expansion_fit(runs: pd.DataFrame, series=(2.0, 1.0, 10.0), n_boot: int = 200
             "paper_slope": paper.EXPANSION_SLOPE}
 
 
+def adstar(runs: pd.DataFrame, barrier_fraction: float = 1.0) -> pd.Series:
+    """Ad / (1 - f E*) per run: f = 1 the paper's Ad*, f = 1/2 with the Coulomb barrier averaged
+    over the deposition; infinite where the particles cannot reach the bed (f E* >= 1)."""
+    rest = 1.0 - barrier_fraction * runs["Estar"]
+    return (runs["Ad"] / rest).where(rest > 0.0, np.inf)
+
+
 def adstar_collapse(runs: pd.DataFrame, barrier_fraction: float = 1.0) -> pd.DataFrame:
     """Fig. 9's claim, quantified: a straight line in log10(Ad*) fitted to the neutral cases'
     mean phi (and <Z>); for every case the deviation of its mean from that line, in units of
@@ -102,8 +109,7 @@ def adstar_collapse(runs: pd.DataFrame, barrier_fraction: float = 1.0) -> pd.Dat
     f = 1/2 is the barrier averaged over a deposition, during which the bed's charge, and with
     it the sheet field an incident particle climbs against, grows from 0 to its final value
     (doc/reproduction.md, "Ad* collapse")."""
-    r = runs.assign(Adstar=runs["Ad"] / (1.0 - barrier_fraction * runs["Estar"]))
-    r.loc[1.0 - barrier_fraction * runs["Estar"] <= 0.0, "Adstar"] = np.inf
+    r = runs.assign(Adstar=adstar(runs, barrier_fraction))
     s = (r.groupby(list(CASE), as_index=False)
          .agg(runs=("phi", "size"), Adstar=("Adstar", "first"), phi=("phi", "mean"),
               phi_sd=("phi", "std"), Z=("Z", "mean"), Z_sd=("Z", "std")))

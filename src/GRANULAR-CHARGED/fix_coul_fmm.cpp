@@ -324,7 +324,7 @@ void FixCoulFMM::setup(int vflag)
   // continue the schedule of the previous run (or of the restart file) when its stored field
   // still belongs to these atoms, charges and box: a run split into pieces, or continued from
   // a restart, then evaluates on the same steps as the uninterrupted run
-  if (!stored_field_valid(true)) {
+  if (!stored_field_valid()) {
     last_computed = -1;
     if (tolerance > 0.0) stride = 1;
   }
@@ -368,34 +368,27 @@ void FixCoulFMM::min_post_force(int vflag)
 }
 
 /* ----------------------------------------------------------------------
-   the stored field can be continued if it was evaluated for the same number of atoms, box
-   and charges (set between runs changes charges: then evaluate afresh) and, at the start of
-   a run, if no atom was moved since the field was last applied
+   at the start of a run the stored field can be continued if it belongs to the same atoms,
+   charges and box (field_continuity; set between runs changes charges: then evaluate afresh)
+   and no atom was moved since the field was last applied
 ------------------------------------------------------------------------- */
 
-bool FixCoulFMM::stored_field_valid(bool same_positions)
+bool FixCoulFMM::stored_field_valid()
 {
-  if (last_computed < 0 || atom->natoms != natoms_computed) return false;
-  if (opts->boundary == gcfmm::Boundary::Periodic2D &&
-      (domain->boxlo[0] != box_computed[0] || domain->boxlo[1] != box_computed[1] ||
-       domain->xprd != box_computed[2] || domain->yprd != box_computed[3]))
-    return false;
-  int changed = 0, changed_all = 0;
+  if (field_continuity() != Continuity::SAME) return false;
+  int moved = 0, moved_all = 0;
   // positions moved by a command between runs (displace_atoms, set): not the state the field
   // was advanced for; unwrapping after a remap may differ in the last bits, hence a tolerance
   const double tol = 1e-12 * MAX(MAX(domain->xprd, domain->yprd), domain->zprd);
   double xu[3];
   for (int i = 0; i < atom->nlocal; i++) {
-    const double q = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
-    if (q != eval_state[i][EVAL_Q]) changed = 1;
-    if (same_positions && q != 0.0) {
-      domain->unmap(atom->x[i], atom->image[i], xu);
-      for (int k = 0; k < 3; k++)
-        if (fabs(xu[k] - eval_state[i][EVAL_LAST_X + k]) > tol) changed = 1;
-    }
+    if (eval_state[i][EVAL_Q] == 0.0) continue;
+    domain->unmap(atom->x[i], atom->image[i], xu);
+    for (int k = 0; k < 3; k++)
+      if (fabs(xu[k] - eval_state[i][EVAL_LAST_X + k]) > tol) moved = 1;
   }
-  MPI_Allreduce(&changed, &changed_all, 1, MPI_INT, MPI_MAX, world);
-  return changed_all == 0;
+  MPI_Allreduce(&moved, &moved_all, 1, MPI_INT, MPI_MAX, world);
+  return moved_all == 0;
 }
 
 /* ----------------------------------------------------------------------

@@ -106,7 +106,7 @@ class FixCoulFMM : public Fix {
   int ilevel_respa;    // rRESPA level at which the Coulomb force is applied (outermost)
 
   void check_other_coul_fmm_fixes();
-  bool stored_field_valid(bool same_positions);
+  bool stored_field_valid();
   enum class Continuity { NONE, SAME, ADDED };
   Continuity field_continuity();
   void compute_field(bool with_slope);
