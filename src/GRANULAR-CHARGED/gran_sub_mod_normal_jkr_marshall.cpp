@@ -54,6 +54,7 @@ void GranSubModNormalJKRMarshall::coeffs_to_local()
   poiss = coeffs[2];          // Poisson's ratio
   cohesion = coeffs[3];       // surface energy gamma per surface (work of adhesion 2 gamma)
   damp = restitution;         // what damping models read through get_damp()
+  touch_reff = -1.0;          // delta_C depends on the coefficients: recompute it
 
   if (!(Emod > 0.0))
     error->all(FLERR, "Illegal jkr/marshall normal model, Young's modulus must be > 0, got {}",
@@ -130,7 +131,12 @@ double GranSubModNormalJKRMarshall::critical_overlap(double reff) const
 bool GranSubModNormalJKRMarshall::touch()
 {
   if (gm->touch) {
-    const double dist_break = gm->radsum + critical_overlap(gm->Reff);
+    // every touching pair asks every step; a monodisperse packing has one R, so cache the cbrt
+    if (gm->Reff != touch_reff) {
+      touch_reff = gm->Reff;
+      touch_deltac = critical_overlap(touch_reff);
+    }
+    const double dist_break = gm->radsum + touch_deltac;
     return gm->rsq < dist_break * dist_break;
   }
   return gm->rsq < gm->radsum * gm->radsum;

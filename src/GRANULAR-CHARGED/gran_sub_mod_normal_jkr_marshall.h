@@ -46,6 +46,8 @@ namespace Granular_NS {
     double restitution;    // e, coefficient of restitution
     double Gmix;           // effective shear modulus
     double F_adhesive;     // adhesive part of the JKR force of the current contact
+    double touch_reff = -1.0;    // R of the last touch() test and its delta_C (cache)
+    double touch_deltac = 0.0;
   };
 
 }    // namespace Granular_NS
