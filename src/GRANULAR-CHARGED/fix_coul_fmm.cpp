@@ -670,7 +670,12 @@ void FixCoulFMM::evaluate_into(double **out, int col)
       solver->set_z_range(domain->boxlo[2], domain->boxhi[2]);
     }
     solver->build(n, gx.data(), gy.data(), gz.data());
-    solver->evaluate(gq.data(), pot, ex, ey, ez, comm->me, comm->nprocs);
+    // the ranks share the work every one of them would otherwise repeat (P2M, far-field
+    // anterpolation): each computes its share, one in-place sum completes it (exact)
+    const gcfmm::PartSum sum = [this](double *data, std::size_t count) {
+      MPI_Allreduce(MPI_IN_PLACE, data, static_cast<int>(count), MPI_DOUBLE, MPI_SUM, world);
+    };
+    solver->evaluate(gq.data(), pot, ex, ey, ez, comm->me, comm->nprocs, sum);
     // the potential whose energy 1/2 sum q_i u_i has minus the applied forces as gradient
     // (differs from pot only for farfield average; doc/theory.md, eq. (4.10))
     solver->energy_potential(pot);

@@ -4,9 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
 #include <numeric>
 #include <random>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include "gcfmm/kernels.hpp"
@@ -397,6 +401,90 @@ TEST(Solver, PartitionsSumBitIdentically) {
       prev = b;
     }
     EXPECT_EQ(prev, p.size());
+  }
+}
+
+// A PartSum for parts running as threads (what MPI_Allreduce does for ranks): every part adds
+// its array into a shared one, waits for all, and copies the total back.
+class ThreadPartSum {
+ public:
+  explicit ThreadPartSum(int nparts) : nparts_(nparts) {}
+  void operator()(double *data, std::size_t count) {
+    std::unique_lock<std::mutex> lock(m_);
+    ++calls_;
+    if (arrived_ == 0) total_.assign(count, 0.0);
+    for (std::size_t i = 0; i < count; ++i) total_[i] += data[i];
+    wait_for_all(lock);
+    std::copy(total_.begin(), total_.end(), data);
+    wait_for_all(lock);  // nobody resets total_ before every part has copied it
+  }
+  int calls() const { return calls_; }  // over all parts
+
+ private:
+  void wait_for_all(std::unique_lock<std::mutex> &lock) {
+    const long gen = generation_;
+    if (++arrived_ == nparts_) {
+      arrived_ = 0;
+      ++generation_;
+      cv_.notify_all();
+    } else {
+      cv_.wait(lock, [&] { return generation_ != gen; });
+    }
+  }
+  int nparts_, arrived_ = 0, calls_ = 0;
+  long generation_ = 0;
+  std::mutex m_;
+  std::condition_variable cv_;
+  std::vector<double> total_;
+};
+
+// With a PartSum the parts split the P2M and the far field's anterpolation; run at the same
+// time, they still sum bit-identically to one part (every summed element comes from one part).
+TEST(Solver, SplitWorkWithPartSumStaysBitIdentical) {
+  for (int periodic = 0; periodic < 2; ++periodic) {
+    auto p = periodic ? gcfmm_test::deposition(3000, 113) : gcfmm_test::random_cube(3000, 113);
+    Options o = periodic ? periodic_opts(1e-4, 1) : Options{};
+    if (periodic) o.farfield = FarField::Exact;  // the far field with its anterpolation
+    auto make = [&] {
+      auto s = std::make_unique<Solver>(o);
+      if (periodic) s->set_box(0, 0, 28, 28);
+      s->build(p.size(), p.x.data(), p.y.data(), p.z.data());
+      return s;
+    };
+    auto one = make();
+    const Field all = run(*one, p);
+    for (int nparts : {2, 3}) {
+      ThreadPartSum sum(nparts);
+      const PartSum part_sum = [&](double *d, std::size_t c) { sum(d, c); };
+      std::vector<std::unique_ptr<Solver>> solvers;
+      std::vector<Field> fields;
+      for (int k = 0; k < nparts; ++k) {
+        solvers.push_back(make());
+        fields.emplace_back(p.size());
+      }
+      std::vector<std::thread> threads;
+      for (int k = 0; k < nparts; ++k)
+        threads.emplace_back([&, k] {
+          Field &f = fields[k];
+          solvers[k]->evaluate(p.q.data(), f.pot.data(), f.ex.data(), f.ey.data(), f.ez.data(), k, nparts,
+                               part_sum);
+        });
+      for (auto &t : threads) t.join();
+      std::size_t mismatches = 0;
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        double pot = 0, ex = 0, ey = 0, ez = 0;
+        for (const Field &f : fields) {
+          pot += f.pot[i];
+          ex += f.ex[i];
+          ey += f.ey[i];
+          ez += f.ez[i];
+        }
+        mismatches += (pot != all.pot[i]) + (ex != all.ex[i]) + (ey != all.ey[i]) + (ez != all.ez[i]);
+      }
+      EXPECT_EQ(mismatches, 0u) << "nparts " << nparts << " periodic " << periodic;
+      // the work was split: one sum for the leaf multipoles, one for the far-field node charges
+      EXPECT_EQ(sum.calls(), nparts * (periodic ? 2 : 1));
+    }
   }
 }
 

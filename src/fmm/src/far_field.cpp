@@ -509,23 +509,30 @@ double PeriodicFarField::sample_error() const {
 
 void PeriodicFarField::evaluate(std::size_t n, const double *x, const double *y, const double *z,
                                 const double *q, std::size_t begin, std::size_t end, double *pot,
-                                double *ex, double *ey, double *ez) const {
+                                double *ex, double *ey, double *ez, int part, int nparts,
+                                const PartSum &sum) const {
   if (!ready()) throw std::logic_error("gcfmm::PeriodicFarField::evaluate: setup() not called");
   if (end > n || begin > end)
     throw std::invalid_argument("gcfmm::PeriodicFarField::evaluate: bad target range");
+  if (nparts < 1 || part < 0 || part >= nparts)
+    throw std::invalid_argument("gcfmm::PeriodicFarField::evaluate: need 0 <= part < nparts");
   const int p = pxy_, pz = pz_, nn = p * p * pz;
   double sx[32], sy[32], sz[32];
-  // anterpolation: node charges W_b = sum_j q_j S(r_j) (exact total charge per box)
+  // anterpolation: node charges W_b = sum_j q_j S(r_j) (exact total charge per box). Every
+  // node sums over j in the same order whichever partition computes it, so splitting the x
+  // nodes a in [a0, a1) among the partitions keeps W bit-identical.
+  const bool split = sum && nparts > 1;
+  const int a0 = split ? p * part / nparts : 0, a1 = split ? p * (part + 1) / nparts : p;
   Eigen::MatrixXd w = Eigen::MatrixXd::Zero(nn, nb_);
   for (std::size_t j = 0; j < n; ++j) {
     double tx, ty, tz;
     const int b = locate(j, x[j], y[j], z[j], &tx, &ty, &tz);
-    if (q[j] == 0.0) continue;
+    if (q[j] == 0.0 || a0 == a1) continue;
     interp_weights(tx, p, tab_xy_.data(), sx, nullptr);
     interp_weights(ty, p, tab_xy_.data(), sy, nullptr);
     interp_weights(tz, pz, tab_z_.data(), sz, nullptr);
     double *col = w.col(b).data();
-    for (int a = 0; a < p; ++a) {
+    for (int a = a0; a < a1; ++a) {
       const double qa = q[j] * sx[a];
       for (int bb = 0; bb < p; ++bb) {
         const double qab = qa * sy[bb];
@@ -534,6 +541,7 @@ void PeriodicFarField::evaluate(std::size_t n, const double *x, const double *y,
       }
     }
   }
+  if (split) sum(w.data(), static_cast<std::size_t>(nn) * nb_);
   Eigen::MatrixXd phi(nn, nb_);
   apply(w.data(), phi.data(), 0, nb_);
   interpolate(phi.data(), x, y, z, begin, end, pot, ex, ey, ez);

@@ -96,7 +96,8 @@ void Solver::build(std::size_t n, const double *x, const double *y, const double
   I.evaluated = false;
 }
 
-void Solver::evaluate(const double *q, double *pot, double *ex, double *ey, double *ez, int part, int nparts) {
+void Solver::evaluate(const double *q, double *pot, double *ex, double *ey, double *ez, int part, int nparts,
+                      const PartSum &sum) {
   Impl &I = *impl_;
   if (!I.built) throw std::runtime_error("gcfmm: evaluate() called before build()");
   if (nparts < 1 || part < 0 || part >= nparts)
@@ -116,11 +117,12 @@ void Solver::evaluate(const double *q, double *pot, double *ex, double *ey, doub
   const TargetRange t = I.range_of(part, nparts);
   I.last_range = t;
   for (std::size_t k = t.begin; k < t.end; ++k) I.sorted_pot[k] = I.sorted_ex[k] = I.sorted_ey[k] = I.sorted_ez[k] = 0.0;
-  s.t_upward = timed([&] { I.upward(); });
+  const PartSum &split = nparts > 1 ? sum : PartSum{};
+  s.t_upward = timed([&] { I.upward(t, split); });
   s.t_m2l = timed([&] { I.m2l(t); });
   s.t_p2p = timed([&] { I.p2p(t); });
   s.t_downward = timed([&] { I.downward(t); });
-  s.t_far = timed([&] { I.far_field(t); });
+  s.t_far = timed([&] { I.far_field(t, part, nparts, split); });
 
   // scatter to the caller's order, back from the length unit h: pot ~ 1/length, E ~ 1/length^2
   const auto &perm = I.tree.perm;

@@ -19,18 +19,27 @@ void Solver::Impl::sort_charges(const double *q) {
 }
 
 // Upward pass: P2M at leaves (eq. (3.9)), M2M to parents (eq. (3.10)); children have larger
-// indices than their parents, so one reverse sweep suffices. Done for all nodes by every part.
-void Solver::Impl::upward() {
+// indices than their parents, so one reverse sweep suffices. With a PartSum each part computes
+// the P2M of the leaves that start in its target range, `sum` completes the leaf multipoles
+// (each is nonzero on one part only: exact), and every part does the M2M sweep, the same
+// operations in the same order as without a split.
+void Solver::Impl::upward(const TargetRange &t, const PartSum &sum) {
   const auto &nodes = tree.nodes;
   const auto &xs = tree.xs, &ys = tree.ys, &zs = tree.zs;
   std::fill(multipole.begin(), multipole.end(), 0.0);
+  for (const auto li : tree.leaves) {
+    const Node &A = nodes[li];
+    if (sum && !(A.begin >= t.begin && A.begin < t.end)) continue;
+    double *Mi = multipole_of(li);
+    ops->p2m_batch(A.count(), xs.data() + A.begin, ys.data() + A.begin, zs.data() + A.begin,
+                   sorted_q.data() + A.begin, A.center, Mi);
+    ops->symmetrize(Mi);
+  }
+  if (sum) sum(multipole.data(), multipole.size());
   for (std::size_t i = nodes.size(); i-- > 0;) {
     const Node &A = nodes[i];
     double *Mi = multipole_of(i);
-    if (A.leaf())
-      ops->p2m_batch(A.count(), xs.data() + A.begin, ys.data() + A.begin, zs.data() + A.begin,
-                     sorted_q.data() + A.begin, A.center, Mi);
-    ops->symmetrize(Mi);
+    if (!A.leaf()) ops->symmetrize(Mi);
     if (A.parent >= 0) ops->m2m(Mi, A.center - nodes[A.parent].center, multipole_of(A.parent));
   }
 }
@@ -95,12 +104,12 @@ void Solver::Impl::downward(const TargetRange &t) {
 
 // The image cells beyond the near block (doc/theory.md, eq. (4.1)): exact (eq. (4.6)) or the
 // average field (eq. (4.7)).
-void Solver::Impl::far_field(const TargetRange &t) {
+void Solver::Impl::far_field(const TargetRange &t, int part, int nparts, const PartSum &sum) {
   if (!periodic()) return;
   const auto &xs = tree.xs, &ys = tree.ys, &zs = tree.zs;
   if (opts.farfield == FarField::Exact) {
     far.evaluate(n, xs.data(), ys.data(), zs.data(), sorted_q.data(), t.begin, t.end, sorted_pot.data(),
-                 sorted_ex.data(), sorted_ey.data(), sorted_ez.data());
+                 sorted_ex.data(), sorted_ey.data(), sorted_ez.data(), part, nparts, sum);
   } else if (opts.farfield == FarField::Average) {
     double blo = opts.bed_zlo * inv_h, bhi = opts.bed_zhi * inv_h;
     if (std::isnan(blo)) {

@@ -145,11 +145,11 @@ struct Solver::Impl {
       if (t.hits(tree.nodes[i])) f(i, tree.nodes[i]);
   }
   void sort_charges(const double *q);
-  void upward();
+  void upward(const detail::TargetRange &t, const PartSum &sum);
   void m2l(const detail::TargetRange &t);
   void p2p(const detail::TargetRange &t);
   void downward(const detail::TargetRange &t);
-  void far_field(const detail::TargetRange &t);
+  void far_field(const detail::TargetRange &t, int part, int nparts, const PartSum &sum);
 };
 
 }  // namespace gcfmm

@@ -11,6 +11,8 @@
 #include <cstddef>
 #include <vector>
 
+#include "gcfmm/types.hpp"
+
 namespace gcfmm {
 
 /**
@@ -75,12 +77,15 @@ class PeriodicFarField {
    * @brief ADDS far-field potential and field at targets i in [begin, end).
    * Sources are all n particles (inside the primary cell). pot, ex, ey, ez are indexed by
    * particle (length >= end); pot may be null.
+   * With a PartSum, work partition `part` of `nparts` anterpolates only its share of the node
+   * charges (a contiguous block of the x nodes) and `sum` completes them; without one every
+   * caller anterpolates them all. Either way the node charges are bit-identical.
    * @throws std::logic_error if setup was not called; std::invalid_argument if a particle
    *         lies outside the stored geometry.
    */
   void evaluate(std::size_t n, const double *x, const double *y, const double *z, const double *q,
                 std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
-                double *ez) const;
+                double *ez, int part = 0, int nparts = 1, const PartSum &sum = nullptr) const;
 
   /// @brief Estimated relative RMS error of the far field: the larger of the error measured
   /// for these parameters in the calibration (setup only) and 20 x the RMS error of the

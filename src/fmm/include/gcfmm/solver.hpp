@@ -10,6 +10,7 @@
 
 #include "gcfmm/kernels.hpp"
 #include "gcfmm/options.hpp"
+#include "gcfmm/types.hpp"
 
 namespace gcfmm {
 
@@ -85,14 +86,18 @@ class Solver {
    *  nothing but get their field. No neutrality is assumed (net charge is allowed).
    *  With nparts > 1 only the targets of work partition `part` (contiguous leaf ranges
    *  balanced by estimated cost, the same on every caller) are computed and all others are
-   *  set to 0; the sum over parts is bit-identical to nparts = 1.
+   *  set to 0; the sum over parts is bit-identical to nparts = 1. With a PartSum (one
+   *  evaluate() call per part running at the same time, e.g. one per MPI rank) the parts
+   *  also split the P2M of the upward pass and the far field's anterpolation, which each part
+   *  otherwise repeats; the results stay bit-identical.
    *  Any length scale works: the solver computes in coordinates relative to its length unit
    *  h (a power of two, see kCoincidenceRadius), so results are bit-identical to those of the
    *  unscaled arithmetic except the average far field (round-off).
    *  @throws CoincidentParticles (a std::runtime_error) if two distinct particles are closer
    *  than kCoincidenceRadius h and either has a nonzero charge (the field would be infinite
    *  or meaningless); std::runtime_error if build() was not called. */
-  void evaluate(const double *q, double *pot, double *ex, double *ey, double *ez, int part = 0, int nparts = 1);
+  void evaluate(const double *q, double *pot, double *ex, double *ey, double *ez, int part = 0, int nparts = 1,
+                const PartSum &sum = nullptr);
 
   /** @brief Per-particle potential u of the energy of the last evaluate(): the energy
    *  U = 1/2 sum_i q_i u_i is the one whose gradient is minus the applied forces q_i E_i

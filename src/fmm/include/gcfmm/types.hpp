@@ -3,7 +3,17 @@
 #ifndef GCFMM_TYPES_HPP
 #define GCFMM_TYPES_HPP
 
+#include <cstddef>
+#include <functional>
+
 namespace gcfmm {
+
+/// Sums `count` doubles element by element over all work partitions, in place, the same result
+/// on every partition (an MPI_Allreduce with MPI_SUM, for example). Given to evaluate(), it
+/// lets the partitions split work each would otherwise repeat; every element it sums is
+/// nonzero on at most one partition, so the sum is exact and the results stay bit-identical
+/// to one partition.
+using PartSum = std::function<void(double *data, std::size_t count)>;
 
 //! A point or vector in 3D.
 struct Vec3 {
