@@ -8,6 +8,8 @@ spread above up to z = 160 r_p; Lx = Ly = 28 r_p sqrt(N/2000); all charges q = 4
 r_p = 1 um; si units. Atoms at rest (no integrator): `run steps` re-evaluates the forces.
 
 Usage: bench_coulomb.py [--sizes 2000 20000 200000] [--lmp build/lmp] [--np 1]
+       bench_coulomb.py --ranks 1 2 [--sizes 200000]   (fix coul/fmm only: time per evaluation
+                                                      on each number of MPI ranks, one run)
 """
 import argparse
 import os
@@ -99,8 +101,12 @@ def main():
     ap.add_argument("--pppm-acc", type=float, nargs="+", default=None,
                     help="pppm accuracy settings (default 1e-6 1e-7 1e-8; 1e-6 1e-7 above N = 20000)")
     ap.add_argument("--no-ewald-direct", action="store_true", help="skip ewald and coul/cut")
+    ap.add_argument("--ranks", type=int, nargs="+", default=None,
+                    help="only fix coul/fmm (first --fmm-acc) on these numbers of MPI ranks")
     args = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="gc-bench-")
+    if args.ranks:
+        return ranks(args, tmp)
     rows = []
     for n in args.sizes:
         data = os.path.join(tmp, f"data.{n}")
@@ -131,6 +137,26 @@ def main():
     print("|---|---|---|---|---|")
     for n, m, s, t, e in rows:
         print(f"| {n} | {m} | {s} | {1e3*t:.1f} | {e:.2e} |")
+
+
+def ranks(args, tmp):
+    """fix coul/fmm on 1, 2, ... ranks: time per evaluation, speed-up over the first rank count,
+    and the largest force difference to it (the partitions are bit-identical by design)."""
+    acc = args.fmm_acc[0]
+    print("| N | accuracy | ranks | time per evaluation (ms) | speed-up | max abs force difference |")
+    print("|---|---|---|---|---|---|")
+    for n in args.sizes:
+        data = os.path.join(tmp, f"data.{n}")
+        write_data(data, n)
+        steps = 5 if n >= 200000 else 20
+        base = None
+        for np_ in args.ranks:
+            t, f = run(args.lmp, np_, data, "fmm", acc, 2 * RP, steps, os.path.join(tmp, f"f.{n}.{np_}"))
+            if base is None:
+                base = (t, f)
+            diff = float(np.abs(f - base[1]).max())
+            print(f"| {n} | {acc} | {np_} | {1e3*t:.1f} | {base[0]/t:.2f} | {diff:.3g} |", flush=True)
+    return 0
 
 
 if __name__ == "__main__":

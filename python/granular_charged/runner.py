@@ -172,6 +172,11 @@ class Runner:
             "flying": lmp["flying"], "wall_s": lmp["wall_s"], "cpu_s": lmp["cpu_s"],
             "image": lmp.get("image"),
         }
-        if "warning" in ana:
-            res["warning"] = ana["warning"]
+        warnings = [ana["warning"]] if "warning" in ana else []
+        if lmp["inserted"] < p.N:
+            # inject sequential stops when the bed's charge turns the next particle back
+            warnings.append(f"only {lmp['inserted']} of {p.N} particles were deposited (log.lammps)")
+        if warnings:
+            res["warning"] = "; ".join(warnings)
+            log.warning("%s: %s", workdir, res["warning"])
         return res
