@@ -670,8 +670,8 @@ void FixCoulFMM::evaluate_into(double **out, int col)
       solver->set_z_range(domain->boxlo[2], domain->boxhi[2]);
     }
     solver->build(n, gx.data(), gy.data(), gz.data());
-    // the ranks share the work every one of them would otherwise repeat (P2M, far-field
-    // anterpolation): each computes its share, one in-place sum completes it (exact)
+    // the ranks share the far field's anterpolation, which every one of them would otherwise
+    // repeat: each computes its share, one in-place sum completes it (exact)
     const gcfmm::PartSum sum = [this](double *data, std::size_t count) {
       MPI_Allreduce(MPI_IN_PLACE, data, static_cast<int>(count), MPI_DOUBLE, MPI_SUM, world);
     };

@@ -118,7 +118,7 @@ void Solver::evaluate(const double *q, double *pot, double *ex, double *ey, doub
   I.last_range = t;
   for (std::size_t k = t.begin; k < t.end; ++k) I.sorted_pot[k] = I.sorted_ex[k] = I.sorted_ey[k] = I.sorted_ez[k] = 0.0;
   const PartSum &split = nparts > 1 ? sum : PartSum{};
-  s.t_upward = timed([&] { I.upward(t, split); });
+  s.t_upward = timed([&] { I.upward(); });
   s.t_m2l = timed([&] { I.m2l(t); });
   s.t_p2p = timed([&] { I.p2p(t); });
   s.t_downward = timed([&] { I.downward(t); });

@@ -19,27 +19,21 @@ void Solver::Impl::sort_charges(const double *q) {
 }
 
 // Upward pass: P2M at leaves (eq. (3.9)), M2M to parents (eq. (3.10)); children have larger
-// indices than their parents, so one reverse sweep suffices. With a PartSum each part computes
-// the P2M of the leaves that start in its target range, `sum` completes the leaf multipoles
-// (each is nonzero on one part only: exact), and every part does the M2M sweep, the same
-// operations in the same order as without a split.
-void Solver::Impl::upward(const TargetRange &t, const PartSum &sum) {
+// indices than their parents, so one reverse sweep suffices. Done for all nodes by every part:
+// splitting the P2M would need the leaf multipoles summed over the parts, and at N = 200,000
+// that sum (~all nodes x expansion size doubles) cost more than the P2M it saved
+// (doc/benchmarks.md, "2 MPI ranks").
+void Solver::Impl::upward() {
   const auto &nodes = tree.nodes;
   const auto &xs = tree.xs, &ys = tree.ys, &zs = tree.zs;
   std::fill(multipole.begin(), multipole.end(), 0.0);
-  for (const auto li : tree.leaves) {
-    const Node &A = nodes[li];
-    if (sum && !(A.begin >= t.begin && A.begin < t.end)) continue;
-    double *Mi = multipole_of(li);
-    ops->p2m_batch(A.count(), xs.data() + A.begin, ys.data() + A.begin, zs.data() + A.begin,
-                   sorted_q.data() + A.begin, A.center, Mi);
-    ops->symmetrize(Mi);
-  }
-  if (sum) sum(multipole.data(), multipole.size());
   for (std::size_t i = nodes.size(); i-- > 0;) {
     const Node &A = nodes[i];
     double *Mi = multipole_of(i);
-    if (!A.leaf()) ops->symmetrize(Mi);
+    if (A.leaf())
+      ops->p2m_batch(A.count(), xs.data() + A.begin, ys.data() + A.begin, zs.data() + A.begin,
+                     sorted_q.data() + A.begin, A.center, Mi);
+    ops->symmetrize(Mi);
     if (A.parent >= 0) ops->m2m(Mi, A.center - nodes[A.parent].center, multipole_of(A.parent));
   }
 }

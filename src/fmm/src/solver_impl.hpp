@@ -145,7 +145,7 @@ struct Solver::Impl {
       if (t.hits(tree.nodes[i])) f(i, tree.nodes[i]);
   }
   void sort_charges(const double *q);
-  void upward(const detail::TargetRange &t, const PartSum &sum);
+  void upward();
   void m2l(const detail::TargetRange &t);
   void p2p(const detail::TargetRange &t);
   void downward(const detail::TargetRange &t);

@@ -88,8 +88,8 @@ class Solver {
    *  balanced by estimated cost, the same on every caller) are computed and all others are
    *  set to 0; the sum over parts is bit-identical to nparts = 1. With a PartSum (one
    *  evaluate() call per part running at the same time, e.g. one per MPI rank) the parts
-   *  also split the P2M of the upward pass and the far field's anterpolation, which each part
-   *  otherwise repeats; the results stay bit-identical.
+   *  also split the far field's anterpolation, which each part otherwise repeats; the results
+   *  stay bit-identical.
    *  Any length scale works: the solver computes in coordinates relative to its length unit
    *  h (a power of two, see kCoincidenceRadius), so results are bit-identical to those of the
    *  unscaled arithmetic except the average far field (round-off).
