@@ -497,9 +497,9 @@ def vs_adstar(results, out: Path):
     df = tables.runs_frame(ok)
     p1 = _phi_Z_vs(df, "Adstar", "Ad* (paper: all its cases have Ad* > 1)",
                    Path(out) / "phi_Z_vs_Adstar.png")
-    # the Coulomb barrier averaged over the deposition (doc/reproduction.md, "Ad* collapse")
+    # half the paper's barrier: the rain's charge in flight (doc/reproduction.md, "Ad* collapse")
     mid = df.assign(Adstar_mid=tables.adstar(df, barrier_fraction=0.5))
-    _phi_Z_vs(mid, "Adstar_mid", "Ad / (1 - E*/2): the barrier averaged over the deposition",
+    _phi_Z_vs(mid, "Adstar_mid", "Ad / (1 - E*/2): half the barrier (the rain's charge in flight)",
               Path(out) / "phi_Z_vs_Adstar_mean_barrier.png")
     return p1, _phase_diagram(df, out)
 

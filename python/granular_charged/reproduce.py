@@ -116,8 +116,8 @@ def report(res: dict, study: Reproduction) -> str:
                      f"{fit['points']} charges with a positive expansion (paper: "
                      f"{paper.EXPANSION_SLOPE:g}); largest expansion "
                      f"{s['expansion'].max():.3f} (paper: up to {paper.MAX_RELATIVE_DECREASE:g})")
-    for name, c in (("Ad* (the paper's, barrier of the finished bed)", c),
-                    ("Ad* with the barrier averaged over the deposition (E*/2)",
+    for name, c in (("Ad* (the paper's: the mean barrier of a one-at-a-time deposition)", c),
+                    ("Ad* with half that barrier (E*/2: the rain's charge in flight halves it)",
                      res["collapse_mid"])):
         if "phi_dev" not in c or not c["phi_line"].notna().any():
             continue

@@ -105,10 +105,10 @@ def adstar_collapse(runs: pd.DataFrame, barrier_fraction: float = 1.0) -> pd.Dat
     the standard error of its mean over the seeds. The charged cases collapse with the neutral
     ones if their deviations are as small as the neutral cases' own.
 
-    Ad* = Ad / (1 - f E*): f = 1 is the paper's (the Coulomb barrier of the finished bed);
-    f = 1/2 is the barrier averaged over a deposition, during which the bed's charge, and with
-    it the sheet field an incident particle climbs against, grows from 0 to its final value
-    (doc/reproduction.md, "Ad* collapse")."""
+    Ad* = Ad / (1 - f E*): f = 1 is the paper's, whose E* is the sheet-field barrier over the
+    injection height averaged over a one-at-a-time deposition; f = 1/2 fits the rain of one
+    particle per r_p, whose charge in flight halves that barrier (doc/reproduction.md, "Ad*
+    collapse" and "One particle at a time")."""
     r = runs.assign(Adstar=adstar(runs, barrier_fraction))
     s = (r.groupby(list(CASE), as_index=False)
          .agg(runs=("phi", "size"), Adstar=("Adstar", "first"), phi=("phi", "mean"),

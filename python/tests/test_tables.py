@@ -50,6 +50,6 @@ def test_adstar_collapse_measures_the_charged_offset():
     assert abs(charged["phi"] - charged["phi_line"] - 0.03) < 1e-12
     assert abs(charged["phi_dev"] - 0.03 / (0.01 / np.sqrt(3))) < 1e-9
     assert np.allclose(c[c["q"] == 0]["phi_dev"], 0.0, atol=1e-9)
-    # the barrier averaged over the deposition: Ad* = Ad / (1 - E*/2), Ad = 4.9 x 0.4
+    # half the barrier: Ad* = Ad / (1 - E*/2), Ad = 4.9 x 0.4
     half = tables.adstar_collapse(runs, barrier_fraction=0.5)
     assert abs(half[half["q"] > 0].iloc[0]["Adstar"] - 4.9 * 0.4 / 0.7) < 1e-12
