@@ -12,8 +12,8 @@ SMALL = ["--N", 25, "--seed", 1, "--var", "L_rp", 6, "--var", "H_rp", 60, "--var
          "sequential", "--no-render"]
 
 
-def _run(cli, tmp_path, q):
-    cli(["-q", "run", "--out", tmp_path, "--q", q, *SMALL], cwd=tmp_path)
+def _run(cli, tmp_path, q, *extra):
+    cli(["-q", "run", "--out", tmp_path, "--q", q, *SMALL, *extra], cwd=tmp_path)
     (wd,) = [d for d in Path(tmp_path).iterdir() if d.is_dir()]
     res = json.loads((wd / "result.json").read_text())
     log = (wd / "log.lammps").read_text()
@@ -45,3 +45,13 @@ def test_sequential_stops_at_the_levitation_limit(cli, tmp_path):
     assert "cannot reach" in log
     assert 1 <= res["inserted"] < 25 and res["natoms"] == res["inserted"]
     assert f"only {res['inserted']} of 25 particles were deposited" in res["warning"]
+
+
+def test_sequential_plane_rain_keeps_its_interval(cli, tmp_path):
+    """seq_gap_rp > 0: a particle every seq_gap_rp r_p / U_0 from the start plane, without
+    waiting for the landing. All 25 are deposited, and the injection phase is exactly 25 runs
+    of ceil(2 r_p / U_0 / dt) = 656 steps (dt = 6.1046 ns for r_p = 2 um, U_0 = 1 m/s)."""
+    res, log = _run(cli, tmp_path, 400, "--var", "seq_gap_rp", 2)
+    assert res["inserted"] == 25 and res["natoms"] == 25 and res["lost"] == 0
+    runs = re.findall(r"^Loop time of \S+ on \d+ procs for (\d+) steps", log, re.M)
+    assert runs.count("656") == 25
