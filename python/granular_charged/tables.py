@@ -93,8 +93,8 @@ def expansion_fit(runs: pd.DataFrame, series=(2.0, 1.0, 10.0), n_boot: int = 200
 
 
 def adstar(runs: pd.DataFrame, barrier_fraction: float = 1.0) -> pd.Series:
-    """Ad / (1 - f E*) per run: f = 1 the paper's Ad*, f = 1/2 with the Coulomb barrier averaged
-    over the deposition; infinite where the particles cannot reach the bed (f E* >= 1)."""
+    """Ad / (1 - f E*) per run (f: see adstar_collapse); infinite where the particles cannot
+    reach the bed (f E* >= 1)."""
     rest = 1.0 - barrier_fraction * runs["Estar"]
     return (runs["Ad"] / rest).where(rest > 0.0, np.inf)
 

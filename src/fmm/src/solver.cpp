@@ -117,12 +117,11 @@ void Solver::evaluate(const double *q, double *pot, double *ex, double *ey, doub
   const TargetRange t = I.range_of(part, nparts);
   I.last_range = t;
   for (std::size_t k = t.begin; k < t.end; ++k) I.sorted_pot[k] = I.sorted_ex[k] = I.sorted_ey[k] = I.sorted_ez[k] = 0.0;
-  const PartSum &split = nparts > 1 ? sum : PartSum{};
   s.t_upward = timed([&] { I.upward(); });
   s.t_m2l = timed([&] { I.m2l(t); });
   s.t_p2p = timed([&] { I.p2p(t); });
   s.t_downward = timed([&] { I.downward(t); });
-  s.t_far = timed([&] { I.far_field(t, part, nparts, split); });
+  s.t_far = timed([&] { I.far_field(t, part, nparts, sum); });
 
   // scatter to the caller's order, back from the length unit h: pot ~ 1/length, E ~ 1/length^2
   const auto &perm = I.tree.perm;
