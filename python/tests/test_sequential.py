@@ -55,3 +55,28 @@ def test_sequential_plane_rain_keeps_its_interval(cli, tmp_path):
     assert res["inserted"] == 25 and res["natoms"] == 25 and res["lost"] == 0
     runs = re.findall(r"^Loop time of \S+ on \d+ procs for (\d+) steps", log, re.M)
     assert runs.count("656") == 25
+
+
+def test_plane_rain_start_plane_follows_the_resting_bed(cli, tmp_path):
+    """In a plane rain two particles can meet in flight (or a pair rebound from the bare floor)
+    and drift upwards while touching. The start plane h = z_top + seq_dz_L L must follow the
+    resting bed, not such a pair: when it followed them, the plane and the lid rose with the
+    pair at N = 2000, L = 28 r_p until h left the box (at this size: h up to 25 r_p and three
+    particles still flying at the end). Asserted: nothing flies at the end, and no start
+    plane was more than seq_dz_L L = 7 r_p (+ 0.5 r_p for the bed's growth between the last
+    two starts) above the final bed top. Measured: 11.5 r_p against 4.7 + 7.5."""
+    rp = 2.0e-6
+    cli(["-q", "run", "--out", tmp_path, "--q", 400, "--N", 40, "--seed", 1, "--var", "L_rp", 28,
+         "--var", "inject", "sequential", "--var", "seq_dz_L", 0.25, "--var", "seq_gap_rp", 4,
+         "--no-render"], cwd=tmp_path)
+    (wd,) = [d for d in Path(tmp_path).iterdir() if d.is_dir()]
+    res = json.loads((wd / "result.json").read_text())
+    log = (wd / "log.lammps").read_text()
+    assert res["inserted"] == 40 and res["flying"] == 0
+    starts = [float(h) for h in re.findall(r"^\s*variable\s+h equal ([0-9.eE+-]+)\s*$", log, re.M)]
+    assert len(starts) == 40
+    # the last thermo block of the sequential section: its columns name c_ztop
+    blocks = re.findall(r"^\s*Step .*c_ztop.*\n((?:\s*[0-9].*\n)+)", log, re.M)
+    header = re.findall(r"^\s*(Step .*c_ztop.*)$", log, re.M)[-1].split()
+    ztop = float(blocks[-1].strip().splitlines()[-1].split()[header.index("c_ztop")])
+    assert max(starts) <= ztop + 7.5 * rp, (max(starts) / rp, ztop / rp)
