@@ -122,7 +122,7 @@ def build_parser() -> argparse.ArgumentParser:
                        help="the reduced Fig. 2 study: runs, table, Table 2, figures",
                        description=DEMO_DESCRIPTION,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
-    _study_options(p, "demo", "deck variables besides the demo's L_rp 14, gap_rp 1")
+    _study_options(p, "demo", "deck variables besides the demo's L_rp 14, inject rain, gap_rp 1")
     p.add_argument("--N", type=int, default=500, help="particles per run (default 500)")
     p.add_argument("--q", type=float, nargs="+", default=[0.0, 260.0, 400.0],
                    help="charges [e0] (default 0 260 400)")

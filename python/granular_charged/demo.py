@@ -24,7 +24,10 @@ from .sweep import Sweep
 
 log = logging.getLogger(__name__)
 
-DEMO_VARS = MappingProxyType({"L_rp": 14, "gap_rp": 1})   # read-only
+# the rain from H at one particle per r_p for every charge: quick, and its incident particles
+# come from H (the tracer figure); charged packings are denser than the deck's default plane
+# rain gives (doc/deposition.md, "Protocol checks")
+DEMO_VARS = MappingProxyType({"L_rp": 14, "inject": "rain", "gap_rp": 1})   # read-only
 FULL_COMMAND = ("granular-charged sweep --preset paper --N 2000 --seeds 1 2 3 "
                 "--out paper-results --figures paper-figures")
 

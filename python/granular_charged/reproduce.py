@@ -57,7 +57,7 @@ class Reproduction:
         return SIZES["quick" if self.quick else "full"]
 
     def params(self, have_fmm: bool) -> list[DepositionParams]:
-        extra = {"L_rp": self.size["L_rp"], "gap_rp": 1, **self.extra}
+        extra = {"L_rp": self.size["L_rp"], "inject": "rain", "gap_rp": 1, **self.extra}
         N = self.size["N"]
         charges = QUICK_CHARGES if self.quick else self.charges
         ps = [DepositionParams(q=q, N=N, seed=s, extra=dict(extra))

@@ -28,7 +28,9 @@ from .params import DepositionParams, coulomb_to_adhesion
 
 log = logging.getLogger(__name__)
 
-RESULT_VERSION = 2
+# 3: charged runs without `inject` now use the plane rain (older results of the same name
+# came from the rain and are run again)
+RESULT_VERSION = 3
 DECKS = ("in.deposition", "in.charged-after-formation")
 
 
