@@ -24,10 +24,11 @@ from .sweep import Sweep
 
 log = logging.getLogger(__name__)
 
-# the rain from H at one particle per r_p for every charge: quick, and its incident particles
-# come from H (the tracer figure); charged packings are denser than the deck's default plane
-# rain gives (doc/deposition.md, "Protocol checks")
-DEMO_VARS = MappingProxyType({"L_rp": 14, "inject": "rain", "gap_rp": 1})   # read-only
+# demo and reproduce: the rain from H at one particle per r_p for every charge: quick, and its
+# incident particles come from H (the tracer figure); charged packings are denser than the
+# deck's default plane rain gives (doc/deposition.md, "Protocol checks")
+STUDY_INJECTION = MappingProxyType({"inject": "rain", "gap_rp": 1})   # read-only
+DEMO_VARS = MappingProxyType({"L_rp": 14, **STUDY_INJECTION})        # read-only
 FULL_COMMAND = ("granular-charged sweep --preset paper --N 2000 --seeds 1 2 3 "
                 "--out paper-results --figures paper-figures")
 

@@ -27,6 +27,7 @@ from pathlib import Path
 
 from . import figures, paper, tables
 from .after_formation import run_table2
+from .demo import STUDY_INJECTION
 from .params import DepositionParams
 from .runner import RunError, Runner
 from .sweep import Sweep
@@ -57,7 +58,7 @@ class Reproduction:
         return SIZES["quick" if self.quick else "full"]
 
     def params(self, have_fmm: bool) -> list[DepositionParams]:
-        extra = {"L_rp": self.size["L_rp"], "inject": "rain", "gap_rp": 1, **self.extra}
+        extra = {"L_rp": self.size["L_rp"], **STUDY_INJECTION, **self.extra}
         N = self.size["N"]
         charges = QUICK_CHARGES if self.quick else self.charges
         ps = [DepositionParams(q=q, N=N, seed=s, extra=dict(extra))

@@ -12,8 +12,8 @@ SMALL = ["--N", 25, "--seed", 1, "--var", "L_rp", 6, "--var", "H_rp", 60, "--var
          "sequential", "--no-render"]
 
 
-def _run(cli, tmp_path, q, *extra):
-    cli(["-q", "run", "--out", tmp_path, "--q", q, *SMALL, *extra], cwd=tmp_path)
+def _run(cli, tmp_path, q, *extra, size=SMALL):
+    cli(["-q", "run", "--out", tmp_path, "--q", q, *size, *extra], cwd=tmp_path)
     (wd,) = [d for d in Path(tmp_path).iterdir() if d.is_dir()]
     res = json.loads((wd / "result.json").read_text())
     log = (wd / "log.lammps").read_text()
@@ -66,12 +66,9 @@ def test_plane_rain_start_plane_follows_the_resting_bed(cli, tmp_path):
     plane was more than seq_dz_L L = 7 r_p (+ 0.5 r_p for the bed's growth between the last
     two starts) above the final bed top. Measured: 11.5 r_p against 4.7 + 7.5."""
     rp = 2.0e-6
-    cli(["-q", "run", "--out", tmp_path, "--q", 400, "--N", 40, "--seed", 1, "--var", "L_rp", 28,
-         "--var", "inject", "sequential", "--var", "seq_dz_L", 0.25, "--var", "seq_gap_rp", 4,
-         "--no-render"], cwd=tmp_path)
-    (wd,) = [d for d in Path(tmp_path).iterdir() if d.is_dir()]
-    res = json.loads((wd / "result.json").read_text())
-    log = (wd / "log.lammps").read_text()
+    res, log = _run(cli, tmp_path, 400, size=[
+        "--N", 40, "--seed", 1, "--var", "L_rp", 28, "--var", "inject", "sequential",
+        "--var", "seq_dz_L", 0.25, "--var", "seq_gap_rp", 4, "--no-render"])
     assert res["inserted"] == 40 and res["flying"] == 0
     starts = [float(h) for h in re.findall(r"^\s*variable\s+h equal ([0-9.eE+-]+)\s*$", log, re.M)]
     assert len(starts) == 40
