@@ -10,6 +10,7 @@
 #include "gran_sub_mod_normal_jkr_marshall.h"
 
 #include "gran_sub_mod_damping_marshall.h"
+#include "jkr_scaled.h"
 
 #include "citeme.h"
 #include "error.h"
@@ -20,7 +21,6 @@
 
 using namespace LAMMPS_NS;
 using namespace Granular_NS;
-using MathConst::MY_2PI;
 using MathConst::MY_PI;
 
 // delta_C = a_0^2 / (2 6^(1/3) R) with a_0^3 = 9 pi gamma R^2 / E
@@ -38,7 +38,7 @@ static const char cite_jkr_marshall[] =
 /* ---------------------------------------------------------------------- */
 
 GranSubModNormalJKRMarshall::GranSubModNormalJKRMarshall(GranularModel *gm, LAMMPS *lmp) :
-    GranSubModNormalJKR(gm, lmp), restitution(0.0), Gmix(0.0), F_adhesive(0.0)
+    GranSubModNormalJKR(gm, lmp), restitution(0.0), Gmix(0.0), F_adhesive(0.0), s_contact(1.0)
 {
   if (lmp->citeme) lmp->citeme->add(cite_jkr_marshall);
 }
@@ -54,7 +54,7 @@ void GranSubModNormalJKRMarshall::coeffs_to_local()
   poiss = coeffs[2];          // Poisson's ratio
   cohesion = coeffs[3];       // surface energy gamma per surface (work of adhesion 2 gamma)
   damp = restitution;         // what damping models read through get_damp()
-  touch_reff = -1.0;          // delta_C depends on the coefficients: recompute it
+  scales_reff = -1.0;         // the scales depend on the coefficients: recompute them
 
   if (!(Emod > 0.0))
     error->all(FLERR, "Illegal jkr/marshall normal model, Young's modulus must be > 0, got {}",
@@ -125,18 +125,28 @@ double GranSubModNormalJKRMarshall::critical_overlap(double reff) const
 }
 
 /* ----------------------------------------------------------------------
+   delta_C, a_sep = a_0 / 6^(2/3) = (pi gamma R^2 / (4 E*))^(1/3) and F_C of radius R
+   (doc/theory.md, eqs. (1.2) and (1.4a)), kept until R changes
+------------------------------------------------------------------------- */
+
+void GranSubModNormalJKRMarshall::set_scales(double reff)
+{
+  scales_reff = reff;
+  scale_deltac = critical_overlap(reff);
+  scale_inv_deltac = (scale_deltac > 0.0) ? 1.0 / scale_deltac : 0.0;
+  scale_asep = cbrt(MY_PI * cohesion * reff * reff / (4.0 * Emix));
+  scale_fc = 3.0 * MY_PI * cohesion * reff;
+}
+
+/* ----------------------------------------------------------------------
    contact life (Marshall 2009): forms at delta >= 0, persists until delta = -delta_C
 ------------------------------------------------------------------------- */
 
 bool GranSubModNormalJKRMarshall::touch()
 {
   if (gm->touch) {
-    // every touching pair asks every step; a monodisperse packing has one R, so cache the cbrt
-    if (gm->Reff != touch_reff) {
-      touch_reff = gm->Reff;
-      touch_deltac = critical_overlap(touch_reff);
-    }
-    const double dist_break = gm->radsum + touch_deltac;
+    use_scales(gm->Reff);
+    const double dist_break = gm->radsum + scale_deltac;
     return gm->rsq < dist_break * dist_break;
   }
   return gm->rsq < gm->radsum * gm->radsum;
@@ -153,19 +163,39 @@ double GranSubModNormalJKRMarshall::pulloff_distance(double radi, double radj)
 }
 
 /* ----------------------------------------------------------------------
+   contact radius on the stable JKR branch: a = a_sep s^2 with s the root of
+   s^4 - 4 s = 3 delta / delta_C (doc/theory.md, eq. (1.4a); jkr_scaled.h). Same a as
+   GranSubModNormalJKR's closed form, without its cube root and four square roots.
+   Without adhesion the law is Hertz's, which the closed form handles.
+------------------------------------------------------------------------- */
+
+double GranSubModNormalJKRMarshall::calculate_contact_radius()
+{
+  if (cohesion == 0.0) return GranSubModNormalJKR::calculate_contact_radius();
+  use_scales(gm->Reff);
+  s_contact = JKRScaled::root(gm->delta * scale_inv_deltac);
+  return scale_asep * s_contact * s_contact;
+}
+
+/* ----------------------------------------------------------------------
    F_ne = 4 F_C ((a/a_0)^3 - (a/a_0)^(3/2))                     (Marshall 2009, eq. 8)
-        = 4 E a^3 / (3 R) - 4 sqrt(pi gamma E a^3)
-   with the contact radius a(delta) of the JKR relation on its stable branch
-   (GranSubModNormalJKR::calculate_contact_radius, checked against the check points of
-   doc/theory.md, eq. (1.4), in the unit tests). F_adhesive = 4 F_C (a/a_0)^(3/2) is kept for rolling marshall.
+        = F_C (s^6 / 9 - 2 s^3 / 3)                             (doc/theory.md, eq. (1.4a))
+   F_adhesive = 4 F_C (a/a_0)^(3/2) = 2 F_C s^3 / 3 is kept for rolling marshall.
+   Without adhesion: Hertz, F_ne = 4 E* a^3 / (3 R).
 ------------------------------------------------------------------------- */
 
 double GranSubModNormalJKRMarshall::calculate_forces()
 {
-  const double a = gm->contact_radius;
-  const double a2 = a * a;
-  F_adhesive = MY_2PI * a2 * sqrt(4.0 * cohesion * Emix / (MY_PI * a));
-  Fne = k * a * a2 / gm->Reff - F_adhesive;
-  F_pulloff = 3.0 * MY_PI * cohesion * gm->Reff;
+  if (cohesion == 0.0) {
+    const double a = gm->contact_radius;
+    F_adhesive = 0.0;
+    F_pulloff = 0.0;
+    Fne = k * a * a * a / gm->Reff;
+    return Fne;
+  }
+  const double s3 = s_contact * s_contact * s_contact;
+  F_adhesive = 2.0 / 3.0 * scale_fc * s3;
+  Fne = JKRScaled::force_over_fc(s_contact) * scale_fc;
+  F_pulloff = scale_fc;
   return Fne;
 }

@@ -33,6 +33,7 @@ namespace Granular_NS {
     void init() override;
     bool touch() override;
     double pulloff_distance(double, double) override;
+    double calculate_contact_radius() override;
     double calculate_forces() override;
 
     double get_emix() const { return Emix; }                    //!< effective modulus E*
@@ -46,8 +47,20 @@ namespace Granular_NS {
     double restitution;    // e, coefficient of restitution
     double Gmix;           // effective shear modulus
     double F_adhesive;     // adhesive part of the JKR force of the current contact
-    double touch_reff = -1.0;    // R of the last touch() test and its delta_C (cache)
-    double touch_deltac = 0.0;
+    double s_contact;      // scaled root s of the current contact (jkr_scaled.h)
+
+    // scales of the last R seen (a monodisperse packing has one R per model, so this cache
+    // spares a cbrt per touching pair and step)
+    double scales_reff = -1.0;
+    double scale_deltac = 0.0;        // delta_C
+    double scale_inv_deltac = 0.0;    // 1 / delta_C (0 without adhesion)
+    double scale_asep = 0.0;          // contact radius at separation, a_0 / 6^(2/3)
+    double scale_fc = 0.0;            // F_C = 3 pi gamma R
+    void use_scales(double reff)
+    {
+      if (reff != scales_reff) set_scales(reff);
+    }
+    void set_scales(double reff);
   };
 
 }    // namespace Granular_NS

@@ -92,22 +92,21 @@ void GranSubModRollingMarshall::calculate_forces()
   if (gm->history_update) {
     const double xin = dot3(xi, gm->nx);
     if (xin != 0.0) {
-      const double len = len3(xi);
+      // drop the normal part and restore the length
+      const double lensq = lensq3(xi);
       scale3(xin, gm->nx, tmp);
       sub3(xi, tmp, xi);
-      const double plen = len3(xi);
-      scale3(plen > 0.0 ? len / plen : 0.0, xi);
+      const double plensq = lensq3(xi);
+      scale3(plensq > 0.0 ? sqrt(lensq / plensq) : 0.0, xi);
     }
     scale3(gm->dt, gm->vrl, tmp);
     add3(xi, tmp, xi);
   }
 
-  // irreversible rolling beyond theta_crit R (R = R_eff, or the particle radius for
-  // marshall/particle: 2 R_eff for a pair, R_eff = r_p at a wall)
   const double radius = (gm->contact_type == PAIR) ? pair_radius_factor * gm->Reff : gm->Reff;
   const double xi_crit = theta_crit * radius;
-  const double len = len3(xi);
-  if (len > xi_crit) scale3(xi_crit / len, xi);
+  const double lensq = lensq3(xi);
+  if (lensq > xi_crit * xi_crit) scale3(xi_crit / sqrt(lensq), xi);
 
   scale3(-jkr->get_adhesive_force() / gm->Reff, xi, gm->fr);
 

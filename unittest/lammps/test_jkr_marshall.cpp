@@ -3,6 +3,7 @@
    independently, in gc_testing.h). Units si: r_p = 1 um, E = 2e8 Pa, nu = 0.33,
    gamma = 0.01 J/m^2, rho = 2500 kg/m^3 (the paper's Table 1). */
 #include "gc_testing.h"
+#include "jkr_scaled.h"
 
 #include "exceptions.h"
 #include "gtest/gtest.h"
@@ -96,6 +97,56 @@ TEST(JKRMarshall, QuasiStaticCheckPoints)
   EXPECT_EQ(force_at(l, -1.001 * dC), 0.0);
   EXPECT_EQ(force_at(l, -0.5 * dC), 0.0);
   EXPECT_NE(force_at(l, 0.1 * dC), 0.0);
+}
+
+// 1b. the scaled root that jkr/marshall solves for its contact radius (jkr_scaled.h): table
+// plus Newton steps against bisection, over the table (u = sqrt(Delta + 1) < 16) and beyond.
+// Away from separation both are exact to ~1 ulp (tolerance 4e-15 relative). Near Delta = -1,
+// s - 1 ~ sqrt((Delta + 1) / 2) and the residual s^4 - 4 s - 3 Delta can only be evaluated to
+// ~1e-15 absolute, so any double-precision root is uncertain by ~1e-15 / (12 (s - 1)).
+TEST(JKRMarshall, ScaledRootAgreesWithBisection)
+{
+  using LAMMPS_NS::JKRScaled::root;
+  using LAMMPS_NS::JKRScaled::root_by_bisection;
+  EXPECT_EQ(root(-1.0), 1.0);
+  EXPECT_EQ(root(-2.0), 1.0);    // clamped: the branch ends at separation
+  for (int k = 0; k <= 20000; ++k) {
+    const double Delta = -1.0 + std::pow(10.0, -12.0 + 17.0 * k / 20000.0);    // up to 1e5
+    const double s = root(Delta), sb = root_by_bisection(Delta);
+    const double tol = 4e-15 * sb + 2e-15 / (12.0 * (sb - 1.0));
+    ASSERT_NEAR(s, sb, tol) << "Delta = " << Delta;
+    // and the law itself: s solves s^4 - 4 s = 3 Delta to rounding of its terms
+    ASSERT_NEAR(s * s * s * s - 4.0 * s, 3.0 * Delta, 1e-14 * (std::fabs(3.0 * Delta) + 4.0 * s));
+  }
+  // F / F_C at separation (s = 1), zero load and pull-off (s^3 = 3): the check points of
+  // doc/theory.md, eq. (1.4)
+  EXPECT_NEAR(LAMMPS_NS::JKRScaled::force_over_fc(1.0), -5.0 / 9.0, 1e-15);
+  EXPECT_NEAR(LAMMPS_NS::JKRScaled::force_over_fc(std::cbrt(3.0)), -1.0, 1e-15);
+  EXPECT_NEAR(LAMMPS_NS::JKRScaled::force_over_fc(std::cbrt(6.0)), 0.0, 1e-15);
+}
+
+// 1c. the pair force along the stable branch, from separation to ~150 delta_C (an overlap of
+// 0.6 r_p here; the root's asymptotic branch beyond Delta = 255 is covered by 1b), against the
+// test's own closed forms in a-hat. The overlap is set through positions: 2 r_p - delta is rounded to ~4e-22 m, i.e.
+// ~1.3e-13 delta_C, which moves F by up to ~1e-13 F_C / sqrt(Delta + 1) (dF/ds = -4/3 F_C and
+// ds/dDelta = 1 / (2 sqrt(2 (Delta + 1))) at separation): the tolerance is twice that plus
+// 1e-10 (1 + |F| / F_C) for the rounding of F.
+TEST(JKRMarshall, ForceAlongTheStableBranch)
+{
+  Lmp l;
+  two_spheres(l, 1.0);
+  const JKR jkr{RP / 2, ESTAR_PAIR, GAMMA};
+  const double FC = jkr.FC(), dC = jkr.deltaC();
+  force_at(l, 2.0 * dC);    // the contact forms in compression, then lives in tension
+  const double ah_sep = std::pow(6.0, -2.0 / 3.0);
+  for (int k = 0; k <= 400; ++k) {
+    const double ah = ah_sep * (1.0 + std::pow(10.0, -6.0 + 7.3 * k / 400.0));
+    const double dd = JKR::delta_of_ahat(ah);
+    const double expect = JKR::force_of_ahat(ah);
+    const double tol = 2e-13 / std::sqrt(dd + 1.0) + 1e-10 * (1.0 + std::fabs(expect));
+    ASSERT_NEAR(force_at(l, dd * dC) / FC, expect, tol)
+        << "a-hat " << ah << ", delta/delta_C " << dd;
+  }
 }
 
 // 2. pull-off: the largest tensile force on unloading is F_C = 3 pi gamma R

@@ -1,0 +1,40 @@
+/* -*- c++ -*- ----------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+// The JKR contact law in the scaled variable s = 6^(1/3) (a / a_0)^(1/2) (doc/theory.md,
+// eq. (1.4a)), where it has no material constant left:
+//
+//   3 delta / delta_C = s^4 - 4 s,    F_ne / F_C = s^6 / 9 - 2 s^3 / 3,    a = a_sep s^2,
+//
+// stable branch s >= 1; s = 1 is the separation point delta = -delta_C. Free of LAMMPS.
+
+#ifndef LMP_GC_JKR_SCALED_H
+#define LMP_GC_JKR_SCALED_H
+
+namespace LAMMPS_NS {
+namespace JKRScaled {
+
+  // The stable root s >= 1 of s^4 - 4 s = 3 Delta for Delta = delta / delta_C >= -1
+  // (Delta < -1 is clamped to -1, s = 1). Accurate to a few units in the last place.
+  double root(double Delta);
+
+  // The same root by bisection (slow; for the table and for tests).
+  double root_by_bisection(double Delta);
+
+  // F_ne / F_C for a root s (doc/theory.md, eq. (1.4a))
+  inline double force_over_fc(double s)
+  {
+    const double s3 = s * s * s;
+    return s3 * (s3 / 9.0 - 2.0 / 3.0);
+  }
+
+}    // namespace JKRScaled
+}    // namespace LAMMPS_NS
+
+#endif
