@@ -822,10 +822,11 @@ void FixCoulFMM::near_pair_difference(double **out, double trend)
       const double rt2 = then[0] * then[0] + then[1] * then[1] + then[2] * then[2];
       if (rn2 >= near_cutsq && (trend < 0.0 || rt2 >= near_cutsq)) continue;
       if (rn2 == 0.0 || rt2 == 0.0) continue;    // coincident atoms are caught at evaluations
-      const double rn = sqrt(rn2), rt = sqrt(rt2);
-      const double sn = q[j] / (rn * rn * rn), st = q[j] / (rt * rt * rt);
+      const double in = 1.0 / sqrt(rn2), it = 1.0 / sqrt(rt2);
+      const double pn = q[j] * in, pt = q[j] * it;    // potentials q_j / r, fields q_j r / r^3
+      const double sn = pn * in * in, st = pt * it * it;
       for (int k = 0; k < 3; k++) e[k] += sn * now[k] - st * then[k];
-      e[3] += q[j] / rn - q[j] / rt;
+      e[3] += pn - pt;
       // a pair that was beyond the cutoff at the later evaluation of the slope has its trend
       // in the slope: take it out, the pair is summed exactly (doc/theory.md, eq. (5.3))
       if (trend > 0.0 && di[DELTA_IN_SLOPE] != 0.0 && dj[DELTA_IN_SLOPE] != 0.0) {
@@ -837,10 +838,11 @@ void FixCoulFMM::near_pair_difference(double **out, double trend)
         const double rb2 = rb[0] * rb[0] + rb[1] * rb[1] + rb[2] * rb[2];
         const double ra2 = ra[0] * ra[0] + ra[1] * ra[1] + ra[2] * ra[2];
         if (rb2 >= near_cutsq && ra2 > 0.0) {
-          const double b = sqrt(rb2), a = sqrt(ra2);
-          const double sb = trend * q[j] / (b * b * b), sa = trend * q[j] / (a * a * a);
+          const double ib = 1.0 / sqrt(rb2), ia = 1.0 / sqrt(ra2);
+          const double pb = trend * q[j] * ib, pa = trend * q[j] * ia;
+          const double sb = pb * ib * ib, sa = pa * ia * ia;
           for (int k = 0; k < 3; k++) e[k] -= sb * rb[k] - sa * ra[k];
-          e[3] -= trend * (q[j] / b - q[j] / a);
+          e[3] -= pb - pa;
         }
       }
     }
