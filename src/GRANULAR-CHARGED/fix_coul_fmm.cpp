@@ -288,8 +288,9 @@ void FixCoulFMM::init()
   }
   logged = false;
 
-  // near refresh: a full list of the pairs closer than the near cutoff, ghosts out to it; with
-  // every 1 each step is an evaluation, so neither the list nor a slope is ever used
+  // near refresh: a half list without newton (each pair once per rank that owns one of its
+  // atoms, so no reverse communication) of the pairs closer than the near cutoff, ghosts out to
+  // it; with every 1 each step is an evaluation, so neither the list nor a slope is ever used
   if (near_cutoff > 0.0 && every == 1 && comm->me == 0)
     error->warning(FLERR, "Fix coul/fmm {}: near has no effect with every 1", id);
   if (tolerance > 0.0 && comm->me == 0 && !logged)
@@ -298,7 +299,7 @@ void FixCoulFMM::init()
                    "time-stepping error of {:.3g}\n",
                    id, every, tolerance);
   if (near_cutoff > 0.0 && every > 1) {
-    auto *req = neighbor->add_request(this, NeighConst::REQ_FULL);
+    auto *req = neighbor->add_request(this, NeighConst::REQ_NEWTON_OFF);
     req->set_cutoff(near_cutoff);
     const double ghost = near_cutoff + neighbor->skin;
     if (ghost > comm->cutghostuser) {
@@ -796,6 +797,9 @@ void FixCoulFMM::near_pair_difference(double **out, double trend)
   }
   comm->forward_comm(this);
 
+  // each pair once: the field at i from j is q_j g(r_ij) with g(r) = r / |r|^3, at j from i
+  // -q_i g(r_ij); the potentials q_j / r and q_i / r. A ghost j is a local atom elsewhere (or
+  // an image here) whose own list holds the pair the other way round: only i is updated.
   const double c = force->qqrd2e, near_cutsq = near_cutoff * near_cutoff;
   double *q = atom->q;
   int *mask = atom->mask;
@@ -823,10 +827,10 @@ void FixCoulFMM::near_pair_difference(double **out, double trend)
       if (rn2 >= near_cutsq && (trend < 0.0 || rt2 >= near_cutsq)) continue;
       if (rn2 == 0.0 || rt2 == 0.0) continue;    // coincident atoms are caught at evaluations
       const double in = 1.0 / sqrt(rn2), it = 1.0 / sqrt(rt2);
-      const double pn = q[j] * in, pt = q[j] * it;    // potentials q_j / r, fields q_j r / r^3
-      const double sn = pn * in * in, st = pt * it * it;
-      for (int k = 0; k < 3; k++) e[k] += sn * now[k] - st * then[k];
-      e[3] += pn - pt;
+      const double sn = in * in * in, st = it * it * it;
+      double dg[4];    // change of g and of 1/r since the evaluation
+      for (int k = 0; k < 3; k++) dg[k] = sn * now[k] - st * then[k];
+      dg[3] = in - it;
       // a pair that was beyond the cutoff at the later evaluation of the slope has its trend
       // in the slope: take it out, the pair is summed exactly (doc/theory.md, eq. (5.3))
       if (trend > 0.0 && di[DELTA_IN_SLOPE] != 0.0 && dj[DELTA_IN_SLOPE] != 0.0) {
@@ -839,15 +843,21 @@ void FixCoulFMM::near_pair_difference(double **out, double trend)
         const double ra2 = ra[0] * ra[0] + ra[1] * ra[1] + ra[2] * ra[2];
         if (rb2 >= near_cutsq && ra2 > 0.0) {
           const double ib = 1.0 / sqrt(rb2), ia = 1.0 / sqrt(ra2);
-          const double pb = trend * q[j] * ib, pa = trend * q[j] * ia;
-          const double sb = pb * ib * ib, sa = pa * ia * ia;
-          for (int k = 0; k < 3; k++) e[k] -= sb * rb[k] - sa * ra[k];
-          e[3] -= pb - pa;
+          const double sb = trend * ib * ib * ib, sa = trend * ia * ia * ia;
+          for (int k = 0; k < 3; k++) dg[k] -= sb * rb[k] - sa * ra[k];
+          dg[3] -= trend * (ib - ia);
         }
       }
+      for (int k = 0; k < 4; k++) e[k] += q[j] * dg[k];
+      if (j < nlocal) {
+        for (int k = 0; k < 3; k++) out[j][k] -= q[i] * dg[k];
+        out[j][3] += q[i] * dg[3];
+      }
     }
-    for (int k = 0; k < 4; k++) out[i][k] = c * e[k];
+    for (int k = 0; k < 4; k++) out[i][k] += e[k];
   }
+  for (int i = 0; i < nlocal; i++)
+    for (int k = 0; k < 4; k++) out[i][k] *= c;
 }
 
 /* ----------------------------------------------------------------------
