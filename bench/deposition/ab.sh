@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The same deposition with two builds, started together (one per core), so that both see the
+# same machine: prints the user CPU seconds of each and their ratio.
+#   bench/deposition/ab.sh <build-dir before> <build-dir after> [-var NAME VALUE ...]
+# e.g. bench/deposition/ab.sh /tmp/before build -var N 500 -var L_rp 14 -var q 400 -var seed 1
+# (a build dir holds lmp and liblammps.so.0; the deck is this checkout's)
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+deck=$here/../../python/granular_charged/decks/in.deposition
+before=$(cd "$1" && pwd); after=$(cd "$2" && pwd); shift 2
+vars=("$@")
+out=$(mktemp -d)
+run() {    # tag build-dir
+  mkdir -p "$out/$1"
+  local TIMEFORMAT=%U
+  { time LD_LIBRARY_PATH="$2${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}" \
+      "$2/lmp" -in "$deck" -var out "$out/$1" -log "$out/$1/log.lammps" -screen none \
+      "${vars[@]}"; } 2> "$out/$1/user"
+}
+run before "$before" &
+run after "$after" &
+wait
+for tag in before after; do
+  steps=$(sed -n 's/^GC RESULT steps \([0-9]*\).*/\1/p' "$out/$tag/log.lammps" | tail -n 1)
+  echo "$tag: $(tail -n 1 "$out/$tag/user") s user CPU, $steps steps"
+done
+awk -v a="$(tail -n 1 "$out/after/user")" -v b="$(tail -n 1 "$out/before/user")" 'BEGIN {printf "after / before %.3f\n", a/b}'
+rm -rf "$out"
