@@ -193,8 +193,7 @@ double GranSubModNormalJKRMarshall::calculate_forces()
     Fne = k * a * a * a / gm->Reff;
     return Fne;
   }
-  const double s3 = s_contact * s_contact * s_contact;
-  F_adhesive = 2.0 / 3.0 * scale_fc * s3;
+  F_adhesive = JKRScaled::adhesive_over_fc(s_contact) * scale_fc;
   Fne = JKRScaled::force_over_fc(s_contact) * scale_fc;
   F_pulloff = scale_fc;
   return Fne;

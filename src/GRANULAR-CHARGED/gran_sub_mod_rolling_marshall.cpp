@@ -103,6 +103,8 @@ void GranSubModRollingMarshall::calculate_forces()
     add3(xi, tmp, xi);
   }
 
+  // irreversible rolling beyond theta_crit R (R = R_eff, or the particle radius for
+  // marshall/particle: 2 R_eff for a pair, R_eff = r_p at a wall)
   const double radius = (gm->contact_type == PAIR) ? pair_radius_factor * gm->Reff : gm->Reff;
   const double xi_crit = theta_crit * radius;
   const double lensq = lensq3(xi);

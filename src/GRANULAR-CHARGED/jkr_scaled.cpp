@@ -30,9 +30,8 @@ double residual(double s, double Delta)
 // one Newton step on g(s) = s^4 - 4 s - 3 Delta; g' = 4 (s^3 - 1) > 0 for s > 1
 double newton_step(double s, double Delta)
 {
-  const double s3 = s * s * s;
-  const double slope = 4.0 * (s3 - 1.0);
-  return slope > 0.0 ? s - (s * (s3 - 4.0) - 3.0 * Delta) / slope : s;
+  const double slope = 4.0 * (s * s * s - 1.0);
+  return slope > 0.0 ? s - residual(s, Delta) / slope : s;
 }
 
 const std::array<double, N_INTERVALS + 2> &table()

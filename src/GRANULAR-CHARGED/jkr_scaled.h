@@ -27,11 +27,17 @@ namespace JKRScaled {
   // The same root by bisection (slow; for the table and for tests).
   double root_by_bisection(double Delta);
 
-  // F_ne / F_C for a root s (doc/theory.md, eq. (1.4a))
+  // adhesive part 4 F_C (a/a_0)^(3/2) over F_C for a root s (doc/theory.md, eq. (1.4a))
+  inline double adhesive_over_fc(double s)
+  {
+    return 2.0 / 3.0 * s * s * s;
+  }
+
+  // F_ne / F_C for a root s (doc/theory.md, eq. (1.4a)): elastic s^6 / 9 minus the adhesive part
   inline double force_over_fc(double s)
   {
     const double s3 = s * s * s;
-    return s3 * (s3 / 9.0 - 2.0 / 3.0);
+    return s3 * s3 / 9.0 - adhesive_over_fc(s);
   }
 
 }    // namespace JKRScaled
