@@ -520,6 +520,43 @@ TEST(PeriodicFarField, ZeroNetForceAndPotentialAtProbe) {
   EXPECT_LT(std::fabs(pot[n - 1] - pr), 1e-6 * 600 * 2 * kPi / (28.0 * 28.0) * 28);
 }
 
+TEST(PeriodicFarField, OccupiedBoxesOnly) {
+  // evaluate applies the operator only from the boxes that hold charges to those that hold
+  // particles. A charged layer in the middle of a column stored from 0 to 160 (empty boxes
+  // above and below it) with probes (q = 0) only below it, or only above it: the probes must
+  // still see the whole layer, from below and from above (the field changes sign).
+  // Reference: brute-force Ewald minus the near block; bound: the requested accuracy.
+  Config layer = thin_layer(300, 28, 21);
+  for (auto &v : layer.z) v = 60 + 7.5 * (v - 10);    // 60 < z < 75
+  for (auto &v : layer.q) v = 1.0;
+  const std::size_t nl = layer.size(), np = 20;
+  for (const double zprobe : {5.0, 120.0}) {
+    Config c = layer;
+    for (std::size_t k = 0; k < np; ++k) {
+      c.x.push_back(28.0 * (k % 7) / 7.0 + 1.0);
+      c.y.push_back(28.0 * (k % 5) / 5.0 + 2.0);
+      c.z.push_back(zprobe + 1.5 * k);
+      c.q.push_back(0.0);
+    }
+    const std::size_t n = c.size();
+    std::vector<std::size_t> targets;
+    for (std::size_t i = 0; i < n; i += (i < nl ? 5 : 1)) targets.push_back(i);
+    const auto ref = reference_far(c, targets, 28, 28, 1);
+    for (double acc : {1e-4, 1e-6}) {
+      PeriodicFarField f;
+      f.setup(0, 0, 28, 28, 0, 160, 1, acc);
+      ASSERT_GE(f.boxes(), 6);
+      std::vector<double> ex(n, 0), ey(n, 0), ez(n, 0);
+      f.evaluate(n, c.x.data(), c.y.data(), c.z.data(), c.q.data(), 0, n, nullptr, ex.data(),
+                 ey.data(), ez.data());
+      const double err = rel_rms_error(ref, ex, ey, ez, targets);
+      std::printf("  layer 60-75, probes from z = %g, accuracy %.0e: relative RMS error %.2e\n",
+                  zprobe, acc, err);
+      EXPECT_LT(err, acc) << "probes from z = " << zprobe;
+    }
+  }
+}
+
 TEST(PeriodicFarField, TargetRangesAddAndAgree) {
   // evaluate ADDS, and splitting the targets into ranges (as the caller does per rank or
   // thread) gives the same numbers: same node charges, same operator, same interpolation, so

@@ -375,9 +375,12 @@ void from_sym(int p, int pz, const Eigen::MatrixXd *u, Eigen::MatrixXd &phi) {
 
 }  // namespace
 
-void PeriodicFarField::apply(const double *wp, double *phip, int src_lo, int src_hi) const {
-  // phi_t = sum_s M_{t-s} w_s over the source boxes s in [src_lo, src_hi), per symmetry block
-  // (K_{-o} = K_o^T, doc/theory.md, eq. (4.6)); w is zero outside the source boxes.
+void PeriodicFarField::apply(const double *wp, double *phip, int src_lo, int src_hi, int tgt_lo,
+                             int tgt_hi) const {
+  // phi_t = sum_s M_{t-s} w_s over the source boxes s in [src_lo, src_hi) and the target boxes
+  // t in [tgt_lo, tgt_hi), per symmetry block (K_{-o} = K_o^T, doc/theory.md, eq. (4.6)); w is
+  // zero outside the source boxes, phi is left zero outside the target boxes. A deposition
+  // occupies a few boxes at the bottom of a column stored to the lid: the empty ones cost nothing.
   const int nn = pxy_ * pxy_ * pz_, nh = nn / 4;
   const Eigen::Map<const Eigen::MatrixXd> w(wp, nn, nb_);
   Eigen::MatrixXd v[4], u[4], phi, tmp;
@@ -388,24 +391,26 @@ void PeriodicFarField::apply(const double *wp, double *phip, int src_lo, int src
       const std::size_t blk = 4 * static_cast<std::size_t>(o) + sym;
       const int r = rank_[blk];
       const double *data = ops_[blk].data();
-      // targets t = s + o: K_o; targets t = s - o: K_{-o} = K_o^T
-      const int up = std::min(src_hi, nb_ - o) - src_lo;
-      const int s0 = std::max(src_lo, o);
-      const bool down = o > 0 && src_hi > s0;
+      // targets t = s + o (K_o) for the sources s in [up_lo, up_hi); targets t = s - o
+      // (K_{-o} = K_o^T) for the sources s in [down_lo, down_hi)
+      const int up_lo = std::max(src_lo, tgt_lo - o), up_hi = std::min(src_hi, tgt_hi - o);
+      const int down_lo = std::max(src_lo, tgt_lo + o), down_hi = std::min(src_hi, tgt_hi + o);
+      const int up = up_hi - up_lo, down = o > 0 ? down_hi - down_lo : 0;
       if (r == nh) {
         const Eigen::Map<const Eigen::MatrixXd> k(data, nh, nh);
-        if (up > 0) u[sym].middleCols(src_lo + o, up).noalias() += k * v[sym].middleCols(src_lo, up);
-        if (down) u[sym].middleCols(s0 - o, src_hi - s0).noalias() += k.transpose() * v[sym].middleCols(s0, src_hi - s0);
+        if (up > 0) u[sym].middleCols(up_lo + o, up).noalias() += k * v[sym].middleCols(up_lo, up);
+        if (down > 0)
+          u[sym].middleCols(down_lo - o, down).noalias() += k.transpose() * v[sym].middleCols(down_lo, down);
       } else {
         // compressed: K_o = U W
         const Eigen::Map<const Eigen::MatrixXd> uf(data, nh, r), wf(data + static_cast<std::size_t>(nh) * r, r, nh);
         if (up > 0) {
-          tmp.noalias() = wf * v[sym].middleCols(src_lo, up);
-          u[sym].middleCols(src_lo + o, up).noalias() += uf * tmp;
+          tmp.noalias() = wf * v[sym].middleCols(up_lo, up);
+          u[sym].middleCols(up_lo + o, up).noalias() += uf * tmp;
         }
-        if (down) {
-          tmp.noalias() = uf.transpose() * v[sym].middleCols(s0, src_hi - s0);
-          u[sym].middleCols(s0 - o, src_hi - s0).noalias() += wf.transpose() * tmp;
+        if (down > 0) {
+          tmp.noalias() = uf.transpose() * v[sym].middleCols(down_lo, down);
+          u[sym].middleCols(down_lo - o, down).noalias() += wf.transpose() * tmp;
         }
       }
     }
@@ -490,7 +495,7 @@ double PeriodicFarField::sample_error() const {
     for (int a = 0; a < p; ++a)
       for (int b = 0; b < p; ++b)
         for (int c = 0; c < pz; ++c) w((a * p + b) * pz + c, bs) = sx[a] * sy[b] * sz[c];
-    apply(w.data(), phi.data(), bs, bs + 1);
+    apply(w.data(), phi.data(), bs, bs + 1, 0, nb_);
     for (int t = 0; t < nt; ++t) {
       xt[t] = x0_ + lx_ * u01(rng);
       yt[t] = y0_ + ly_ * u01(rng);
@@ -524,10 +529,19 @@ void PeriodicFarField::evaluate(std::size_t n, const double *x, const double *y,
   const bool split = sum && nparts > 1;
   const int a0 = split ? p * part / nparts : 0, a1 = split ? p * (part + 1) / nparts : p;
   Eigen::MatrixXd w = Eigen::MatrixXd::Zero(nn, nb_);
+  // the boxes holding particles (targets) and charges (sources): taken over all n particles,
+  // not over [begin, end), so that every partition applies the same products and the sum of
+  // the partitions stays bit-identical to one evaluation of all targets
+  int src_lo = nb_, src_hi = 0, tgt_lo = nb_, tgt_hi = 0;
   for (std::size_t j = 0; j < n; ++j) {
     double tx, ty, tz;
     const int b = locate(j, x[j], y[j], z[j], &tx, &ty, &tz);
-    if (q[j] == 0.0 || a0 == a1) continue;
+    tgt_lo = std::min(tgt_lo, b);
+    tgt_hi = std::max(tgt_hi, b + 1);
+    if (q[j] == 0.0) continue;
+    src_lo = std::min(src_lo, b);
+    src_hi = std::max(src_hi, b + 1);
+    if (a0 == a1) continue;
     interp_weights(tx, p, tab_xy_.data(), sx, nullptr);
     interp_weights(ty, p, tab_xy_.data(), sy, nullptr);
     interp_weights(tz, pz, tab_z_.data(), sz, nullptr);
@@ -543,7 +557,7 @@ void PeriodicFarField::evaluate(std::size_t n, const double *x, const double *y,
   }
   if (split) sum(w.data(), static_cast<std::size_t>(nn) * nb_);
   Eigen::MatrixXd phi(nn, nb_);
-  apply(w.data(), phi.data(), 0, nb_);
+  apply(w.data(), phi.data(), src_lo, src_hi, tgt_lo, tgt_hi);
   interpolate(phi.data(), x, y, z, begin, end, pot, ex, ey, ez);
 }
 

@@ -29,7 +29,8 @@ namespace gcfmm {
  * derivative. R is even in dx and dy and the nodes are mirror-symmetric, so each M_o is
  * block diagonal in even/odd node combinations (4 blocks of size (p^2 pz / 4)^2; p even).
  * Cost: set-up evaluates R once per distinct |node difference| and fills nb x 4 blocks;
- * evaluate costs O(N p^2 pz + nb^2 (p^2 pz)^2 / 4), independent of the particle distribution.
+ * evaluate costs O(N p^2 pz + ns nt (p^2 pz)^2 / 4), ns and nt the spans of boxes holding
+ * sources and targets (at most nb).
  * Parameters (p, pz, hz) per accuracy and measured errors/costs: doc/fmm-far-field.md.
  *
  * Conventions: pot_i = sum_j q_j R(r_i - r_j) (all j, including j = i: R is smooth at 0 and
@@ -112,8 +113,9 @@ class PeriodicFarField {
 
  private:
   static void interp_weights(double t, int p, const double *tab, double *s, double *ds);
-  // node charges -> node potentials, (p^2 pz) x nb, from the source boxes [src_lo, src_hi) only
-  void apply(const double *w, double *phi, int src_lo, int src_hi) const;
+  // node charges -> node potentials, (p^2 pz) x nb, from the source boxes [src_lo, src_hi) at
+  // the target boxes [tgt_lo, tgt_hi) only (the other columns of phi are zero)
+  void apply(const double *w, double *phi, int src_lo, int src_hi, int tgt_lo, int tgt_hi) const;
   int locate(std::size_t i, double x, double y, double z, double *tx, double *ty, double *tz) const;
   void interpolate(const double *phi, const double *x, const double *y, const double *z,
                    std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
