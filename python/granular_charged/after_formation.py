@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import logging
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from . import tables
@@ -17,9 +18,11 @@ from .runner import RunError, Runner, read_result, write_json
 log = logging.getLogger(__name__)
 
 
-def run_table2(runner: Runner, formed: Path, qs, out: Path, extra: dict | None = None) -> list[dict]:
-    """One charged-after-formation run per charge in out/q<q>/ (resumable); writes
-    out/table2.csv (ours beside the paper's Table 2) and returns the rows."""
+def run_table2(runner: Runner, formed: Path, qs, out: Path, extra: dict | None = None,
+               jobs: int = 1) -> list[dict]:
+    """One charged-after-formation run per charge in out/q<q>/ (resumable; up to `jobs` at a
+    time); writes out/table2.csv (ours beside the paper's Table 2) and returns the rows in the
+    order of qs."""
     formed = Path(formed).resolve()
     res_formed = read_result(formed / "result.json")
     if res_formed is None:
@@ -29,17 +32,16 @@ def run_table2(runner: Runner, formed: Path, qs, out: Path, extra: dict | None =
         raise RunError("the formed packing must be neutral (q = 0)")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    rows = []
-    for q in qs:
+
+    def one(q) -> dict:
         wd = out / f"q{q:g}"
         rf = wd / "result.json"
         if rf.exists():
             try:
                 r = json.loads(rf.read_text())
                 r["dir"] = str(wd)
-                rows.append(r)
                 log.debug("table 2, q = %g: finished before", q)
-                continue
+                return r
             except ValueError:
                 pass
         v = {k: p[k] for k in ("rp", "U0", "gamma", "rho", "E", "nu", "e", "mu", "theta_crit")}
@@ -55,9 +57,15 @@ def run_table2(runner: Runner, formed: Path, qs, out: Path, extra: dict | None =
                   "FC_over_FE": coulomb_to_adhesion(p["gamma"], p["rp"], q)})
         write_json(rf, r)
         r["dir"] = str(wd)
-        rows.append(r)
         log.info("table 2, q = %g e0: phi %.5f -> %.5f, <Z> %.4f -> %.4f (%.0f s)", q,
                  r["phi_before"], r["phi_after"], r["Z_before"], r["Z_after"], r["wall_s"])
+        return r
+
+    if jobs > 1 and len(qs) > 1:
+        with ThreadPoolExecutor(min(jobs, len(qs))) as ex:
+            rows = list(ex.map(one, qs))    # each run is a LAMMPS subprocess
+    else:
+        rows = [one(q) for q in qs]
     tables.table2_frame(rows).to_csv(out / "table2.csv", index=False)
     return rows
 
@@ -74,11 +82,12 @@ def main(argv=None) -> int:
     ap.add_argument("--out", required=True)
     ap.add_argument("--build-dir", default=None)
     ap.add_argument("--np", type=int, default=1)
+    ap.add_argument("--jobs", type=int, default=1, help="runs at a time")
     ap.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"))
     a = ap.parse_args(argv)
     setup_logging(0, 0)
     runner = Runner(LammpsBuild.find(a.build_dir), np_ranks=a.np)
-    rows = run_table2(runner, Path(a.formed), a.q, Path(a.out), dict(a.var))
+    rows = run_table2(runner, Path(a.formed), a.q, Path(a.out), dict(a.var), jobs=a.jobs)
     print(tables.format_table(tables.table2_frame(rows), "{:.5g}"))
     return 0
 

@@ -73,7 +73,8 @@ class Study:
         if neutral and have_fmm and self.table2_qs:
             try:
                 t2 = run_table2(runner, Path(neutral[0]["dir"]), self.table2_qs, out / "table2",
-                                {"coul_every": self.extra.get("coul_every", 10)})
+                                {k: v for k, v in self.extra.items() if k.startswith("coul_")},
+                                jobs=self.jobs)
             except RunError as e:
                 log.error("Table 2 check FAILED: %s", e)
         figs = figures.all_figures(results, out / "figures", t2)
