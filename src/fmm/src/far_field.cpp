@@ -555,7 +555,9 @@ void PeriodicFarField::evaluate(std::size_t n, const double *x, const double *y,
       }
     }
   }
-  if (split) sum(w.data(), static_cast<std::size_t>(nn) * nb_);
+  // only the source boxes' node charges are nonzero (columns are contiguous)
+  if (split && src_hi > src_lo)
+    sum(w.col(src_lo).data(), static_cast<std::size_t>(nn) * (src_hi - src_lo));
   Eigen::MatrixXd phi(nn, nb_);
   apply(w.data(), phi.data(), src_lo, src_hi, tgt_lo, tgt_hi);
   interpolate(phi.data(), x, y, z, begin, end, pot, ex, ey, ez);
