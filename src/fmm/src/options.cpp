@@ -53,8 +53,12 @@ double predicted_error(int order, double theta) {
 
 Resolved resolve(const Options &o) {
   Resolved r;
-  constexpr double kDefaultTheta = 0.6;  // the fastest of 0.5/0.6/0.7 at equal error (doc/fmm-accuracy.md)
-  r.theta = o.theta > 0.0 ? o.theta : kDefaultTheta;
+  // a wider opening angle moves pairs from P2P (which dominates at loose requests) to M2L at a
+  // higher order: 0.7 is the faster choice down to 3e-4, 0.6 below (both geometries, N = 500 to
+  // 200,000: doc/fmm-accuracy.md, "Opening angle by accuracy"). 0.8 was faster still at >= 3e-3
+  // but broke the model's bound at N = 500 (1.04 and 1.10 x the request), so it is not used.
+  constexpr double kLooseTheta = 0.7, kTightTheta = 0.6, kLooseFrom = 3e-4;
+  r.theta = o.theta > 0.0 ? o.theta : (o.accuracy >= kLooseFrom ? kLooseTheta : kTightTheta);
   if (o.order > 0) {
     r.order = o.order;
   } else {
