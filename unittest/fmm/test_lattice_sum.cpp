@@ -396,7 +396,7 @@ std::vector<std::size_t> sample_targets(std::size_t n, std::size_t m) {
 void check_far_field(const Config &c, double lx, double ly, double zlo, double zhi, const char *name) {
   const auto targets = sample_targets(c.size(), 96);
   const auto ref = reference_far(c, targets, lx, ly, 1);
-  // 1e-2 and 3e-3 take the cheapest parameter set, 1e-3 and 3e-4 the next one
+  // 1e-2 and 3e-3 take the loose parameter set (p = 6, pz = 6), 1e-3 the next one
   for (double acc : {1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 1e-5, 1e-6}) {
     PeriodicFarField f;
     f.setup(0, 0, lx, ly, zlo, zhi, 1, acc);
