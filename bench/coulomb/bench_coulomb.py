@@ -14,6 +14,7 @@ Usage: bench_coulomb.py [--sizes 2000 20000 200000] [--lmp build/lmp] [--np 1] [
 import argparse
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -117,8 +118,14 @@ def main():
                     help="only fix coul/fmm (first --fmm-acc) on these numbers of MPI ranks")
     args = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="gc-bench-")
-    if args.ranks:
-        return ranks(args, tmp)
+    try:
+        return ranks(args, tmp) if args.ranks else compare(args, tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def compare(args, tmp):
+    """fix coul/fmm against pppm (+ ewald and coul/cut): time per evaluation and error."""
     rows = []
     for n in args.sizes:
         data = os.path.join(tmp, f"data.{n}")
