@@ -26,33 +26,32 @@ constexpr double kPi = 3.14159265358979323846;
 
 namespace {
 
-// Parameter sets per requested accuracy 10^-d, d = 3 .. 8, from the calibration scan in
-// unittest/fmm/test_lattice_sum.cpp (DISABLED_Calibration; table in doc/fmm-far-field.md):
-// the largest relative RMS far-field error measured for the deposition geometry (2000
-// charges +-1) and a thin neutral layer (300 charges +-1) is `measured`; each set keeps it
-// at least 3 times below the requested accuracy (2.4 times at 1e-8).
+// Parameter sets from the calibration scan in unittest/fmm/test_lattice_sum.cpp
+// (DISABLED_Calibration; table in doc/fmm-far-field.md): `measured` is the largest relative RMS
+// far-field error measured for the deposition geometry (2000 charges +-1) and a thin neutral
+// layer (300 charges +-1). A request takes the first set whose `from` it reaches; each set keeps
+// `measured` at least 3 times below the requests it serves (2.4 times at 1e-8). The loosest set
+// starts at 3e-3, not at 3 x 6.3e-4: below 3e-3 its estimate would take the printed total
+// (near-field model plus far field) above the request.
 struct ParamSet {
+  double from;
   int pxy, pz;
   double hz_over_l, measured;
 };
 constexpr ParamSet kParams[] = {
-    {8, 6, 1.0, 7.7e-5},    // 1e-3
-    {8, 8, 1.0, 3.2e-5},    // 1e-4
-    {10, 8, 1.0, 2.6e-6},   // 1e-5
-    {12, 10, 1.0, 7.8e-8},  // 1e-6
-    {14, 12, 1.0, 4.3e-9},  // 1e-7
-    {14, 12, 0.7, 4.3e-9},  // 1e-8
+    {3e-3, 6, 6, 1.0, 6.3e-4},
+    {1e-3, 8, 6, 1.0, 7.7e-5},
+    {1e-4, 8, 8, 1.0, 3.2e-5},
+    {1e-5, 10, 8, 1.0, 2.6e-6},
+    {1e-6, 12, 10, 1.0, 7.8e-8},
+    {1e-7, 14, 12, 1.0, 4.3e-9},
+    {0.0, 14, 12, 0.7, 4.3e-9},    // down to 1e-8
 };
-// Loose requests (>= 3e-3, 4.8 times its measured error) take a cheaper set. (Below 3e-3 the
-// near field's share of the error budget leaves too little room: with this set's estimate the
-// printed total would exceed the request.)
-constexpr ParamSet kLooseParams = {6, 6, 1.0, 6.3e-4};
-constexpr double kLooseFrom = 3e-3;
 
 const ParamSet &params_for(double accuracy) {
-  if (accuracy >= kLooseFrom) return kLooseParams;
-  const int d = static_cast<int>(std::ceil(-std::log10(accuracy) - 1e-9));
-  return kParams[std::max(0, d - 3)];
+  const ParamSet *ps = kParams;
+  while (accuracy < ps->from) ++ps;    // the last set's `from` is 0
+  return *ps;
 }
 
 }  // namespace
@@ -403,13 +402,13 @@ void PeriodicFarField::apply(const double *wp, double *phip, int src_lo, int src
     for (int o = 0; o < nb_; ++o) {
       const std::size_t blk = 4 * static_cast<std::size_t>(o) + sym;
       const int r = rank_[blk];
+      if (r == 0) continue;    // zero to the compression tolerance
       const double *data = ops_[blk].data();
       // targets t = s + o (K_o) for the sources s in [up_lo, up_hi); targets t = s - o
       // (K_{-o} = K_o^T) for the sources s in [down_lo, down_hi)
       const int up_lo = std::max(src_lo, tgt_lo - o), up_hi = std::min(src_hi, tgt_hi - o);
       const int down_lo = std::max(src_lo, tgt_lo + o), down_hi = std::min(src_hi, tgt_hi + o);
       const int up = up_hi - up_lo, down = o > 0 ? down_hi - down_lo : 0;
-      if (r == 0) continue;    // zero to the compression tolerance
       if (r == nh) {
         const Eigen::Map<const Eigen::MatrixXd> k(data, nh, nh);
         if (up > 0) u[sym].middleCols(up_lo + o, up).noalias() += k * v[sym].middleCols(up_lo, up);
