@@ -33,6 +33,9 @@ namespace Granular_NS {
     void init() override;
     double calculate_forces() override;
 
+    double get_alpha() const { return alpha; }                //!< alpha(e)
+    double get_mass_factor() const { return mass_factor; }    //!< 2, or 1 for marshall/printed
+
    protected:
     GranSubModNormalJKRMarshall *jkr;    // normal model, for E*
     double alpha;                        // alpha(e)

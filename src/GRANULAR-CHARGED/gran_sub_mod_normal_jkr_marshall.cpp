@@ -10,7 +10,6 @@
 #include "gran_sub_mod_normal_jkr_marshall.h"
 
 #include "gran_sub_mod_damping_marshall.h"
-#include "jkr_scaled.h"
 
 #include "citeme.h"
 #include "error.h"
@@ -21,11 +20,12 @@
 
 using namespace LAMMPS_NS;
 using namespace Granular_NS;
-using MathConst::MY_PI;
+using namespace MarshallKernels;
 
-// delta_C = a_0^2 / (2 6^(1/3) R) with a_0^3 = 9 pi gamma R^2 / E
-//         = DELTAC_PREFIX * (R gamma^2 / E^2)^(1/3)
-static constexpr double DELTAC_PREFIX = 2.5537664411075656;    // (9 pi)^(2/3) / (2 6^(1/3))
+// a flat wall (region radius 0) is a sphere of radius r_p's partner R = r_p; the region search
+// radius is the break distance of R = 2 r_p, so that concave region walls (curvature radius
+// >= 2 r_p, R <= 2 r_p) keep their contacts to delta_C; touch() decides with the wall's own R
+static constexpr double REGION_SEARCH_R_FACTOR = 2.0;
 
 static const char cite_jkr_marshall[] =
     "GRANULAR-CHARGED jkr/marshall contact model: doi:10.1016/j.jcp.2008.10.035\n\n"
@@ -38,7 +38,7 @@ static const char cite_jkr_marshall[] =
 /* ---------------------------------------------------------------------- */
 
 GranSubModNormalJKRMarshall::GranSubModNormalJKRMarshall(GranularModel *gm, LAMMPS *lmp) :
-    GranSubModNormalJKR(gm, lmp), restitution(0.0), Gmix(0.0), F_adhesive(0.0), s_contact(1.0)
+    GranSubModNormalJKR(gm, lmp), restitution(0.0), Gmix(0.0), contact()
 {
   if (lmp->citeme) lmp->citeme->add(cite_jkr_marshall);
 }
@@ -54,7 +54,7 @@ void GranSubModNormalJKRMarshall::coeffs_to_local()
   poiss = coeffs[2];          // Poisson's ratio
   cohesion = coeffs[3];       // surface energy gamma per surface (work of adhesion 2 gamma)
   damp = restitution;         // what damping models read through get_damp()
-  scales_reff = -1.0;         // the scales depend on the coefficients: recompute them
+  scales = JKRScales();       // the scales depend on the coefficients: recompute them
 
   if (!(Emod > 0.0))
     error->all(FLERR, "Illegal jkr/marshall normal model, Young's modulus must be > 0, got {}",
@@ -116,85 +116,59 @@ void GranSubModNormalJKRMarshall::init()
                gm->damping_model->name);
 }
 
-/* ---------------------------------------------------------------------- */
-
-double GranSubModNormalJKRMarshall::critical_overlap(double reff) const
-{
-  if (cohesion == 0.0 || reff <= 0.0) return 0.0;
-  return DELTAC_PREFIX * cbrt(reff * cohesion * cohesion / (Emix * Emix));
-}
-
-/* ----------------------------------------------------------------------
-   delta_C, a_sep = a_0 / 6^(2/3) = (pi gamma R^2 / (4 E*))^(1/3) and F_C of radius R
-   (doc/theory.md, eqs. (1.2) and (1.4a)), kept until R changes
-------------------------------------------------------------------------- */
-
-void GranSubModNormalJKRMarshall::set_scales(double reff)
-{
-  scales_reff = reff;
-  scale_deltac = critical_overlap(reff);
-  scale_inv_deltac = (scale_deltac > 0.0) ? 1.0 / scale_deltac : 0.0;
-  scale_asep = cbrt(MY_PI * cohesion * reff * reff / (4.0 * Emix));
-  scale_fc = 3.0 * MY_PI * cohesion * reff;
-}
-
 /* ----------------------------------------------------------------------
    contact life (Marshall 2009): forms at delta >= 0, persists until delta = -delta_C
 ------------------------------------------------------------------------- */
 
 bool GranSubModNormalJKRMarshall::touch()
 {
-  if (gm->touch) {
-    use_scales(gm->Reff);
-    const double dist_break = gm->radsum + scale_deltac;
-    return gm->rsq < dist_break * dist_break;
-  }
-  return gm->rsq < gm->radsum * gm->radsum;
+  use_jkr_scales(scales, gm->Reff, cohesion, Emix);
+  return jkr_touch(gm->touch, gm->rsq, gm->radsum, scales.deltac);
 }
 
 /* ----------------------------------------------------------------------
-   neighbor cutoff beyond touching: delta_C (called outside compute())
+   neighbor cutoff beyond touching: delta_C (called outside compute()). radj = 0 is a wall:
+   fix wall/gran/region asks pulloff_distance(r_p, 0) for its search radius
 ------------------------------------------------------------------------- */
 
 double GranSubModNormalJKRMarshall::pulloff_distance(double radi, double radj)
 {
+  if (radj == 0.0) return critical_overlap(REGION_SEARCH_R_FACTOR * radi, cohesion, Emix);
   if (radi + radj <= 0.0) return 0.0;
-  return critical_overlap(radi * radj / (radi + radj));
+  return critical_overlap(radi * radj / (radi + radj), cohesion, Emix);
 }
 
 /* ----------------------------------------------------------------------
-   contact radius on the stable JKR branch: a = a_sep s^2 with s the root of
-   s^4 - 4 s = 3 delta / delta_C (doc/theory.md, eq. (1.4a); jkr_scaled.h). Same a as
-   GranSubModNormalJKR's closed form, without its cube root and four square roots.
-   Without adhesion the law is Hertz's, which the closed form handles.
+   contact radius and force of the contact (marshall_kernels.h: jkr_normal_force), the radius
+   on the stable JKR branch a = a_sep s^2 with s^4 - 4 s = 3 delta / delta_C
+   (doc/theory.md, eq. (1.4a)); without adhesion Hertz's a = sqrt(delta R)
 ------------------------------------------------------------------------- */
 
 double GranSubModNormalJKRMarshall::calculate_contact_radius()
 {
-  if (cohesion == 0.0) return GranSubModNormalJKR::calculate_contact_radius();
-  use_scales(gm->Reff);
-  s_contact = JKRScaled::root(gm->delta * scale_inv_deltac);
-  return scale_asep * s_contact * s_contact;
+  use_jkr_scales(scales, gm->Reff, cohesion, Emix);
+  contact = jkr_normal_force(scales, cohesion, Emix, gm->delta, gm->Reff);
+  return contact.a;
 }
 
 /* ----------------------------------------------------------------------
    F_ne = 4 F_C ((a/a_0)^3 - (a/a_0)^(3/2))                     (Marshall 2009, eq. 8)
         = F_C (s^6 / 9 - 2 s^3 / 3)                             (doc/theory.md, eq. (1.4a))
-   F_adhesive = 4 F_C (a/a_0)^(3/2) = 2 F_C s^3 / 3 is kept for rolling marshall.
-   Without adhesion: Hertz, F_ne = 4 E* a^3 / (3 R).
+   of the contact whose radius calculate_contact_radius() found; without adhesion Hertz.
 ------------------------------------------------------------------------- */
 
 double GranSubModNormalJKRMarshall::calculate_forces()
 {
-  if (cohesion == 0.0) {
-    const double a = gm->contact_radius;
-    F_adhesive = 0.0;
-    F_pulloff = 0.0;
-    Fne = k * a * a * a / gm->Reff;
-    return Fne;
-  }
-  F_adhesive = JKRScaled::adhesive_over_fc(s_contact) * scale_fc;
-  Fne = JKRScaled::force_over_fc(s_contact) * scale_fc;
-  F_pulloff = scale_fc;
+  F_pulloff = contact.pulloff;
+  Fne = contact.fne;
   return Fne;
+}
+
+/* ----------------------------------------------------------------------
+   F_crit = |F_ne + 2 F_C| for the friction limits (paper eq. 4)
+------------------------------------------------------------------------- */
+
+void GranSubModNormalJKRMarshall::set_fncrit()
+{
+  Fncrit = critical_force(contact);
 }

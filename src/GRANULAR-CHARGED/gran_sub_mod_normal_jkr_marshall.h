@@ -17,6 +17,7 @@ GranSubModStyle(jkr/marshall,GranSubModNormalJKRMarshall,NORMAL);
 #define GRAN_SUB_MOD_NORMAL_JKR_MARSHALL_H
 
 #include "gran_sub_mod_normal.h"
+#include "marshall_kernels.h"
 
 namespace LAMMPS_NS {
 namespace Granular_NS {
@@ -35,32 +36,21 @@ namespace Granular_NS {
     double pulloff_distance(double, double) override;
     double calculate_contact_radius() override;
     double calculate_forces() override;
+    void set_fncrit() override;
 
     double get_emix() const { return Emix; }                    //!< effective modulus E*
     double get_gmix() const { return Gmix; }                    //!< effective shear modulus G*
+    double get_surface_energy() const { return cohesion; }      //!< gamma
     double get_restitution() const { return restitution; }      //!< e, for damping marshall
-    double get_pulloff_force() const { return F_pulloff; }      //!< F_C = 3 pi gamma R
-    double get_adhesive_force() const { return F_adhesive; }    //!< 4 F_C (a/a_0)^(3/2)
-    double critical_overlap(double reff) const;                 //!< delta_C for this R
+    double get_adhesive_force() const { return contact.adhesive; }    //!< 4 F_C (a/a_0)^(3/2)
 
    protected:
     double restitution;    // e, coefficient of restitution
     double Gmix;           // effective shear modulus
-    double F_adhesive;     // adhesive part of the JKR force of the current contact
-    double s_contact;      // scaled root s of the current contact (jkr_scaled.h)
-
-    // scales of the last R seen (a monodisperse packing has one R per model, so this cache
-    // spares a cbrt per touching pair and step)
-    double scales_reff = -1.0;
-    double scale_deltac = 0.0;        // delta_C
-    double scale_inv_deltac = 0.0;    // 1 / delta_C (0 without adhesion)
-    double scale_asep = 0.0;          // contact radius at separation, a_0 / 6^(2/3)
-    double scale_fc = 0.0;            // F_C = 3 pi gamma R
-    void use_scales(double reff)
-    {
-      if (reff != scales_reff) set_scales(reff);
-    }
-    void set_scales(double reff);
+    // the current contact: computed with its contact radius, read by calculate_forces() and by
+    // rolling marshall (LAMMPS asks for the radius first, then for the force)
+    MarshallKernels::NormalForce contact;
+    MarshallKernels::JKRScales scales;    // delta_C, a_sep, F_C of the last R seen
   };
 
 }    // namespace Granular_NS

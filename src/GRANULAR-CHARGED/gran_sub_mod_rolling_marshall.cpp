@@ -12,13 +12,10 @@
 #include "error.h"
 #include "gran_sub_mod_normal_jkr_marshall.h"
 #include "granular_model.h"
-#include "math_extra.h"
-
-#include <cmath>
+#include "marshall_kernels.h"
 
 using namespace LAMMPS_NS;
 using namespace Granular_NS;
-using namespace MathExtra;
 
 /* ---------------------------------------------------------------------- */
 
@@ -75,42 +72,16 @@ void GranSubModRollingMarshall::init()
 }
 
 /* ----------------------------------------------------------------------
-   Rolling displacement xi = integral of v_L dt in the tangent plane, with LAMMPS's rolling
-   velocity v_L = R (omega_i - omega_j) x n (Wang et al., Particuology 23, 49 (2015), eq. 31),
-   history rotated into the current tangent plane keeping its length.
-   Moment M_r = -k_R n x xi, k_R = 4 F_C (a/a_0)^(3/2)   (paper eq. 3; Marshall 2009)
-   |xi| is capped at theta_crit R: M_r,crit = k_R theta_crit R   (paper eq. 4)
-   GranularModel applies torque_i += R n x fr, so fr = -(k_R / R) xi.
+   Rolling displacement xi = integral of v_L dt in the tangent plane, moment
+   M_r = -k_R n x xi, k_R = 4 F_C (a/a_0)^(3/2), |xi| capped at theta_crit R  (paper eqs. 3-4;
+   marshall_kernels.h: rolling_force). R = R_eff, or the particle radius for marshall/particle:
+   2 R_eff for a pair, R_eff = r_p at a wall.
 ------------------------------------------------------------------------- */
 
 void GranSubModRollingMarshall::calculate_forces()
 {
-  double xi[3], tmp[3];
-  double *history = &gm->history[history_index];
-  copy3(history, xi);
-
-  if (gm->history_update) {
-    const double xin = dot3(xi, gm->nx);
-    if (xin != 0.0) {
-      // drop the normal part and restore the length
-      const double lensq = lensq3(xi);
-      scale3(xin, gm->nx, tmp);
-      sub3(xi, tmp, xi);
-      const double plensq = lensq3(xi);
-      scale3(plensq > 0.0 ? sqrt(lensq / plensq) : 0.0, xi);
-    }
-    scale3(gm->dt, gm->vrl, tmp);
-    add3(xi, tmp, xi);
-  }
-
-  // irreversible rolling beyond theta_crit R (R = R_eff, or the particle radius for
-  // marshall/particle: 2 R_eff for a pair, R_eff = r_p at a wall)
   const double radius = (gm->contact_type == PAIR) ? pair_radius_factor * gm->Reff : gm->Reff;
-  const double xi_crit = theta_crit * radius;
-  const double lensq = lensq3(xi);
-  if (lensq > xi_crit * xi_crit) scale3(xi_crit / sqrt(lensq), xi);
-
-  scale3(-jkr->get_adhesive_force() / gm->Reff, xi, gm->fr);
-
-  if (gm->history_update) copy3(xi, history);
+  MarshallKernels::rolling_force(&gm->history[history_index], gm->nx, gm->vrl, gm->dt,
+                                 theta_crit * radius, jkr->get_adhesive_force() / gm->Reff,
+                                 gm->history_update, gm->fr);
 }

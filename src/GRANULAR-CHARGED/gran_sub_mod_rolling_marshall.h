@@ -35,6 +35,9 @@ namespace Granular_NS {
     void init() override;
     void calculate_forces() override;
 
+    double get_theta_crit() const { return theta_crit; }                    //!< theta_crit
+    double get_pair_radius_factor() const { return pair_radius_factor; }    //!< 1, or 2
+
    protected:
     GranSubModNormalJKRMarshall *jkr;    // normal model, for k_R
     double theta_crit;                   // critical rolling angle

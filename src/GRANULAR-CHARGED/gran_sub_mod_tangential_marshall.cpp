@@ -12,7 +12,9 @@
 #include "error.h"
 #include "gran_sub_mod_normal.h"
 #include "gran_sub_mod_normal_jkr_marshall.h"
+#include "gran_sub_mod_damping.h"
 #include "granular_model.h"
+#include "marshall_kernels.h"
 
 using namespace LAMMPS_NS;
 using namespace Granular_NS;
@@ -72,4 +74,24 @@ void GranSubModTangentialMarshall::init()
     k = 8.0 *
         (gm->contact_type == PAIR ? mix_stiffnessG(E, E, nu, nu) : mix_stiffnessG_wall(E, nu));
   }
+}
+
+/* ----------------------------------------------------------------------
+   F_t = -k_T h - eta_T v_t, |F_t| <= mu F_crit (marshall_kernels.h: tangential_force)
+------------------------------------------------------------------------- */
+
+void GranSubModTangentialMarshall::calculate_forces()
+{
+#if GC_LAMMPS_VERSION >= 20260704
+  // the half-step normal of synchronized verlet is the built-in model's business
+  if (gm->synchronized_verlet == 1) {
+    GranSubModTangentialMindlin::calculate_forces();
+    return;
+  }
+#endif
+  damp = xt * gm->damping_model->get_damp_prefactor();
+  MarshallKernels::tangential_force(&gm->history[history_index], gm->nx, gm->vtr, gm->dt,
+                                    k * gm->contact_radius, damp,
+                                    gm->normal_model->get_fncrit() * mu, gm->history_update,
+                                    gm->fs);
 }

@@ -13,13 +13,10 @@
 #include "gran_sub_mod_normal.h"
 #include "gran_sub_mod_tangential.h"
 #include "granular_model.h"
-
-#include <cmath>
+#include "marshall_kernels.h"
 
 using namespace LAMMPS_NS;
 using namespace Granular_NS;
-
-static constexpr double THREEPI_16 = 0.5890486225480862;    // 3 pi / 16
 
 /* ---------------------------------------------------------------------- */
 
@@ -56,30 +53,17 @@ void GranSubModTwistingMarshallJKR::init()
 }
 
 /* ----------------------------------------------------------------------
-   M_t = -k_tw phi - eta_tw omega_T,  k_tw = k_T a^2 / 2 = 4 G* a^3,
-   eta_tw = eta_T a^2 / 2                        (Marshall 2009, eqs. 29-32)
-   |M_t| <= M_crit = 3 pi a F_crit / 16, F_crit = mu |F_ne + 2 F_C|   (paper eq. 4)
-   On slip the moment keeps the sign of the trial moment and the twist angle is reset to the
-   value that produces exactly M_crit (as the sliding model does).
+   M_t = -k_tw phi - eta_tw omega_T,  k_tw = k_T a^2 / 2 = 4 G* a^3, eta_tw = eta_T a^2 / 2
+   (Marshall 2009, eqs. 29-32), |M_t| <= 3 pi a F_crit / 16 (paper eq. 4)
+   (marshall_kernels.h: twisting_moment)
 ------------------------------------------------------------------------- */
 
 GC_TWISTING_RESULT GranSubModTwistingMarshallJKR::calculate_forces()
 {
-  const double a = gm->contact_radius;
-  const double k = 0.5 * k_tang * a * a * a;
-  const double damp = 0.5 * gm->tangential_model->get_damp() * a * a;
-  const double Mcrit = THREEPI_16 * a * mu_tang * gm->normal_model->get_fncrit();
-
-  double &phi = gm->history[history_index];
-  double angle = phi;
-  if (gm->history_update) angle += gm->magtwist * gm->dt;
-
-  double moment = -k * angle - damp * gm->magtwist;
-  if (fabs(moment) > Mcrit) {
-    moment = (moment > 0.0) ? Mcrit : -Mcrit;
-    angle = (k > 0.0) ? -(moment + damp * gm->magtwist) / k : 0.0;
-  }
-  if (gm->history_update) phi = angle;
+  const double moment = MarshallKernels::twisting_moment(
+      gm->history[history_index], gm->magtwist, gm->dt, gm->contact_radius, k_tang,
+      gm->tangential_model->get_damp(), mu_tang * gm->normal_model->get_fncrit(),
+      gm->history_update);
   gm->magtortwist = moment;
 #if GC_TWISTING_RETURNS_MOMENT
   return moment;

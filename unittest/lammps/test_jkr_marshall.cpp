@@ -11,6 +11,7 @@
 #include <cmath>
 #include <regex>
 #include <string>
+#include <vector>
 
 using gctest::JKR;
 using gctest::Lmp;
@@ -164,30 +165,77 @@ TEST(JKRMarshall, PullOffForce)
 }
 
 // 5. the wall: same law with R = r_p; pull-off 3 pi gamma r_p
-TEST(JKRMarshall, WallForceLaw)
+// The same law against every wall form: the zplane wall of fix wall/gran and flat and curved
+// walls of fix wall/gran/region. A flat wall is a sphere's partner of R = r_p; a region wall of
+// curvature radius R_w (LAMMPS: negative inside a sphere region) gives R = r_p R_w / (r_p + R_w).
+// The region wall asks the normal model for its search radius with pulloff_distance(r_p, 0),
+// which used to give delta_C = 0: the contact let go at zero overlap (F = 0 for delta <= 0).
+struct WallForm {
+  const char *name;
+  std::vector<std::string> commands;    // after create_box; the sphere sits at z_of(delta)
+  double reff;                          // R of the contact
+  double z_contact;                     // z of the sphere centre at delta = 0
+  double z_sign;                        // +1: delta grows as z falls
+};
+
+class WallForceLaw : public ::testing::TestWithParam<int> {};
+
+WallForm wall_form(int k)
 {
+  const std::string model = contact_model(1.0);
+  const double rs = 4.0 * RP;    // sphere region: the sphere rests inside it, below its centre
+  switch (k) {
+    case 0:
+      return {"zplane", {"fix floor all wall/gran granular " + model + " zplane 0.0 NULL"}, RP, RP, 1.0};
+    case 1:
+      return {"region plane",
+              {"region floor plane 0 0 0 0 0 1 side in",
+               "fix floor all wall/gran/region granular " + model + " region floor"},
+              RP, RP, 1.0};
+    case 2:
+      return {"region block",
+              {"region floor block INF INF INF INF 0 INF side in",
+               "fix floor all wall/gran/region granular " + model + " region floor"},
+              RP, RP, 1.0};
+    default:
+      return {"region sphere (inside, R_w = 4 r_p)",
+              {"region bowl sphere 5e-6 5e-6 5e-6 4e-6 side in",
+               "fix floor all wall/gran/region granular " + model + " region bowl"},
+              RP * rs / (rs - RP), 5e-6 - (rs - RP), 1.0};
+  }
+}
+
+TEST_P(WallForceLaw, AgreesWithTheClosedForm)
+{
+  const WallForm w = wall_form(GetParam());
+  SCOPED_TRACE(w.name);
   Lmp l;
   l.cmds({"units si", "atom_style sphere", "atom_modify map array", "boundary p p f",
           "comm_modify vel yes", "region box block 0 1e-5 0 1e-5 0 1e-5", "create_box 1 box",
-          fmt::format("create_atoms 1 single 5e-6 5e-6 {}", RP),
+          fmt::format("create_atoms 1 single 5e-6 5e-6 {}", w.z_contact),
           fmt::format("set type 1 diameter {}", 2 * RP), fmt::format("set type 1 density {}", RHO),
           "pair_style granular", "pair_coeff * * " + contact_model(1.0), "neighbor 2e-7 bin",
-          "timestep 1e-10",
-          "fix floor all wall/gran granular " + contact_model(1.0) + " zplane 0.0 NULL"});
-  const JKR wall{RP, EMOD / (2.0 * (1.0 - NU * NU)), GAMMA};    // R = r_p, E* of like materials
+          "timestep 1e-10"});
+  l.cmds(w.commands);
+  const JKR wall{w.reff, EMOD / (2.0 * (1.0 - NU * NU)), GAMMA};    // E* of like materials
   auto fz_at = [&](double delta) {
-    l.cmd(fmt::format("set atom 1 z {:.17g}", RP - delta));
+    l.cmd(fmt::format("set atom 1 z {:.17g}", w.z_contact - w.z_sign * delta));
     l.cmd("run 0 post no");
     return l.var("fz[1]");
   };
   EXPECT_EQ(fz_at(-0.5 * wall.deltaC()), 0.0);
   double fmin = 0.0;
-  for (double dd : {1.5, 1.0, 0.3}) EXPECT_NEAR(fz_at(dd * wall.deltaC()) / wall.FC(), wall.force(dd * wall.deltaC()) / wall.FC(), 1e-6);
+  // 1e-6: the scaled root is good to a few ulps; the region's distance to its surface carries
+  // the rounding of positions ~5e-6 m, 1e-16 relative, far below 1e-6 of delta_C ~ 4e-9 m
+  for (double dd : {1.5, 1.0, 0.3, 0.0})
+    EXPECT_NEAR(fz_at(dd * wall.deltaC()) / wall.FC(), wall.force(dd * wall.deltaC()) / wall.FC(), 1e-6);
   for (double dd = 0.0; dd >= -0.99; dd -= 1e-3) fmin = std::min(fmin, fz_at(dd * wall.deltaC()));
-  EXPECT_NEAR(fmin / (3.0 * M_PI * GAMMA * RP), -1.0, 1e-5);
+  EXPECT_NEAR(fmin / wall.FC(), -1.0, 1e-5);
   EXPECT_NEAR(fz_at(-(1.0 - 1e-10) * wall.deltaC()) / wall.FC(), -5.0 / 9.0, 1e-4);
   EXPECT_EQ(fz_at(-1.001 * wall.deltaC()), 0.0);
 }
+
+INSTANTIATE_TEST_SUITE_P(JKRMarshall, WallForceLaw, ::testing::Values(0, 1, 2, 3));
 
 // ---- collisions ---------------------------------------------------------------------------
 

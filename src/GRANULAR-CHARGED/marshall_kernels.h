@@ -1,0 +1,253 @@
+/* -*- c++ -*- ----------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+// The equations of the Marshall (2009) contact model as stateless inline functions: the one
+// home of each formula, called by the sub-model classes (gran_sub_mod_*_marshall*.cpp, which
+// are the plumbing between LAMMPS's GranularModel and these functions) and by the fused kernel
+// of pair_style granular/opt. Same shape as the gran_sub_mod_*_kernel.h headers of LAMMPS's
+// development branch. Depends only on the header-only MathExtra and on jkr_scaled.h.
+// Equation numbers: doc/theory.md.
+
+#ifndef LMP_GC_MARSHALL_KERNELS_H
+#define LMP_GC_MARSHALL_KERNELS_H
+
+#include "jkr_scaled.h"
+#include "math_extra.h"
+
+#include <cmath>
+
+namespace LAMMPS_NS {
+namespace MarshallKernels {
+
+  // delta_C = a_0^2 / (2 6^(1/3) R) with a_0^3 = 9 pi gamma R^2 / E
+  //         = DELTAC_PREFIX * (R gamma^2 / E^2)^(1/3)
+  static constexpr double DELTAC_PREFIX = 2.5537664411075656;    // (9 pi)^(2/3) / (2 6^(1/3))
+  static constexpr double PI = 3.14159265358979323846;
+  static constexpr double THREEPI_16 = 0.5890486225480862;    // 3 pi / 16
+  // frame-rotation threshold of the tangential history, LAMMPS's EPSILON in
+  // gran_sub_mod_tangential.cpp (rotating a history already in the plane changes nothing)
+  static constexpr double FRAME_EPSILON = 1e-10;
+
+  /* ---------------------------------------------------------------------
+     JKR scales of one effective radius R (doc/theory.md, eqs. (1.2), (1.4a))
+  --------------------------------------------------------------------- */
+
+  // critical overlap delta_C: the contact breaks at delta = -delta_C (0 without adhesion)
+  inline double critical_overlap(double reff, double gamma, double emix)
+  {
+    if (gamma == 0.0 || reff <= 0.0) return 0.0;
+    return DELTAC_PREFIX * cbrt(reff * gamma * gamma / (emix * emix));
+  }
+
+  struct JKRScales {
+    double reff = -1.0;          // R these scales belong to (-1: none yet)
+    double deltac = 0.0;         // delta_C
+    double inv_deltac = 0.0;     // 1 / delta_C (0 without adhesion)
+    double asep = 0.0;           // contact radius at separation, a_0 / 6^(2/3)
+    double fc = 0.0;             // F_C = 3 pi gamma R
+  };
+
+  // delta_C, a_sep = (pi gamma R^2 / (4 E*))^(1/3) and F_C for radius R, recomputed only when R
+  // changes (a monodisperse packing has one R per type pair: one cbrt per run, not per contact)
+  inline void use_jkr_scales(JKRScales &sc, double reff, double gamma, double emix)
+  {
+    if (reff == sc.reff) return;
+    sc.reff = reff;
+    sc.deltac = critical_overlap(reff, gamma, emix);
+    sc.inv_deltac = (sc.deltac > 0.0) ? 1.0 / sc.deltac : 0.0;
+    sc.asep = cbrt(PI * gamma * reff * reff / (4.0 * emix));
+    sc.fc = 3.0 * PI * gamma * reff;
+  }
+
+  // contact life (Marshall 2009): forms at delta >= 0, persists in tension to delta = -delta_C
+  inline bool jkr_touch(bool was_touching, double rsq, double radsum, double deltac)
+  {
+    const double dist_break = was_touching ? radsum + deltac : radsum;
+    return rsq < dist_break * dist_break;
+  }
+
+  /* ---------------------------------------------------------------------
+     normal force
+  --------------------------------------------------------------------- */
+
+  struct NormalForce {
+    double a;           // contact radius
+    double fne;         // elastic-adhesive normal force F_ne (positive: repulsive)
+    double adhesive;    // adhesive part 4 F_C (a/a_0)^(3/2), for rolling marshall
+    double pulloff;     // F_C (0 without adhesion)
+  };
+
+  // JKR contact radius on the stable branch, a = a_sep s^2 with s^4 - 4 s = 3 delta / delta_C
+  // (eq. (1.4a); jkr_scaled.h), and F_ne = 4 F_C ((a/a_0)^3 - (a/a_0)^(3/2))
+  // = F_C (s^6 / 9 - 2 s^3 / 3)  (Marshall 2009, eq. 8). Without adhesion Hertz's law:
+  // a = sqrt(delta R), F_ne = 4 E* a^3 / (3 R).
+  inline NormalForce jkr_normal_force(const JKRScales &sc, double gamma, double emix,
+                                      double delta, double reff)
+  {
+    NormalForce n;
+    if (gamma == 0.0) {
+      const double dR = delta * reff;
+      n.a = sqrt(dR > 0.0 ? dR : 0.0);
+      n.fne = 4.0 / 3.0 * emix * n.a * n.a * n.a / reff;
+      n.adhesive = 0.0;
+      n.pulloff = 0.0;
+      return n;
+    }
+    const double s = JKRScaled::root(delta * sc.inv_deltac);
+    n.a = sc.asep * s * s;
+    n.adhesive = JKRScaled::adhesive_over_fc(s) * sc.fc;
+    n.fne = JKRScaled::force_over_fc(s) * sc.fc;
+    n.pulloff = sc.fc;
+    return n;
+  }
+
+  // F_crit = |F_ne + 2 F_C|: the normal load the friction limits scale with (paper eq. 4;
+  // LAMMPS's GranSubModNormalJKR::set_fncrit)
+  inline double critical_force(const NormalForce &n)
+  {
+    return fabs(n.fne + 2.0 * n.pulloff);
+  }
+
+  /* ---------------------------------------------------------------------
+     normal damping: F_nd = -eta_N v_n, eta_N = alpha(e) sqrt(mass_factor m* k_N),
+     k_N = 4/3 E* a  (doc/theory.md, eqs. (1.5)-(1.6))
+  --------------------------------------------------------------------- */
+
+  // alpha(e) = 1.2728 - 4.2783 e + 11.087 e^2 - 22.348 e^3 + 27.467 e^4 - 18.022 e^5
+  //            + 4.8218 e^6  (Tsuji et al., Powder Technol. 71, 239 (1992); paper eq. 2).
+  // The fit is 1e-4 off zero at e = 1: no damping means none, and never negative damping.
+  inline double damping_alpha(double e)
+  {
+    const double alpha = 1.2728 +
+        e * (-4.2783 + e * (11.087 + e * (-22.348 + e * (27.467 + e * (-18.022 + e * 4.8218)))));
+    return (e == 1.0 || alpha < 0.0) ? 0.0 : alpha;
+  }
+
+  // eta_N; a >= 0.30285 a_0 > 0 for every live JKR contact, so k_N > 0 also in tension
+  inline double damping_prefactor(double alpha, double mass_factor, double meff, double emix,
+                                  double a)
+  {
+    const double kn = 4.0 / 3.0 * emix * a;
+    return alpha * sqrt(mass_factor * meff * (kn > 0.0 ? kn : 0.0));
+  }
+
+  /* ---------------------------------------------------------------------
+     sliding: spring-dashpot-slider on the tangential displacement h (history, 3 values),
+     F_t = -k_T h - eta_T v_t, k_T = 8 G* a, |F_t| <= mu F_crit  (Marshall 2009, eq. 24).
+     h is first rotated into the current tangent plane keeping its length (Luding, Gran.
+     Matter 10, 235 (2008), eq. 17), then advanced by v_t dt; on slip F_t is scaled to the limit
+     and h reset to the spring length that gives its elastic part. Same operations as LAMMPS
+     4Jul2026's mindlin (history of the displacement, no unloading rescale).
+  --------------------------------------------------------------------- */
+
+  // v -= (v . n) n, then restore |v| (LAMMPS's GranSubMod::rotate_rescale_vec)
+  inline void rotate_into_plane(double *v, const double *n)
+  {
+    const double rsht = MathExtra::dot3(v, n);
+    const double shrmag = MathExtra::len3(v);
+    double along[3];
+    MathExtra::scale3(rsht, n, along);
+    MathExtra::sub3(v, along, v);
+    const double prjmag = MathExtra::len3(v);
+    MathExtra::scale3(prjmag > 0 ? shrmag / prjmag : 0, v);
+  }
+
+  inline void tangential_force(double *history, const double *nx, const double *vtr, double dt,
+                               double k_scaled, double damp, double fscrit, bool history_update,
+                               double *fs)
+  {
+    if (history_update) {
+      const double rsht = MathExtra::dot3(history, nx);
+      if ((fabs(rsht) * k_scaled) > (FRAME_EPSILON * fscrit)) rotate_into_plane(history, nx);
+      double increment[3];
+      MathExtra::scale3(dt, vtr, increment);
+      MathExtra::add3(history, increment, history);
+    }
+    double fdamp[3];
+    MathExtra::scale3(-k_scaled, history, fs);
+    MathExtra::scale3(-damp, vtr, fdamp);
+    MathExtra::add3(fs, fdamp, fs);
+
+    const double magfs = MathExtra::len3(fs);
+    if (magfs > fscrit) {
+      if (MathExtra::len3(history) != 0.0) {
+        MathExtra::scale3(fscrit / magfs, fs);
+        MathExtra::sub3(fs, fdamp, history);
+        MathExtra::scale3(-1.0 / k_scaled, history);
+      } else {
+        MathExtra::zero3(fs);
+      }
+    }
+  }
+
+  /* ---------------------------------------------------------------------
+     rolling: rolling displacement xi = integral of v_L dt in the tangent plane (history,
+     3 values), v_L = R (omega_i - omega_j) x n (Wang et al., Particuology 23, 49 (2015),
+     eq. 31), rotated into the current plane keeping its length; moment M_r = -k_R n x xi with
+     k_R = 4 F_C (a/a_0)^(3/2), |xi| capped at xi_crit = theta_crit R (paper eqs. 3-4).
+     GranularModel applies torque_i += R n x fr, hence fr = -(k_R / R) xi.
+  --------------------------------------------------------------------- */
+
+  inline void rolling_force(double *history, const double *nx, const double *vrl, double dt,
+                            double xi_crit, double k_over_reff, bool history_update, double *fr)
+  {
+    double xi[3], tmp[3];
+    MathExtra::copy3(history, xi);
+    if (history_update) {
+      const double xin = MathExtra::dot3(xi, nx);
+      if (xin != 0.0) {
+        // drop the normal part and restore the length
+        const double lensq = MathExtra::lensq3(xi);
+        MathExtra::scale3(xin, nx, tmp);
+        MathExtra::sub3(xi, tmp, xi);
+        const double plensq = MathExtra::lensq3(xi);
+        MathExtra::scale3(plensq > 0.0 ? sqrt(lensq / plensq) : 0.0, xi);
+      }
+      MathExtra::scale3(dt, vrl, tmp);
+      MathExtra::add3(xi, tmp, xi);
+    }
+    // irreversible rolling beyond theta_crit R
+    const double lensq = MathExtra::lensq3(xi);
+    if (lensq > xi_crit * xi_crit) MathExtra::scale3(xi_crit / sqrt(lensq), xi);
+
+    MathExtra::scale3(-k_over_reff, xi, fr);
+    if (history_update) MathExtra::copy3(xi, history);
+  }
+
+  /* ---------------------------------------------------------------------
+     twisting: M_t = -k_tw phi - eta_tw omega_T, k_tw = k_T a^2 / 2 = 4 G* a^3,
+     eta_tw = eta_T a^2 / 2 (Marshall 2009, eqs. 29-32), |M_t| <= M_crit = 3 pi a F_crit / 16
+     (paper eq. 4). On slip the moment keeps the sign of the trial moment and the twist angle
+     phi (history, 1 value) is reset to the value that produces exactly M_crit.
+     Arguments: k_t = 8 G* (per unit contact radius), eta_t = eta_N, mu_fcrit = mu F_crit.
+  --------------------------------------------------------------------- */
+
+  inline double twisting_moment(double &phi, double magtwist, double dt, double a, double k_t,
+                                double eta_t, double mu_fcrit, bool history_update)
+  {
+    const double k = 0.5 * k_t * a * a * a;
+    const double damp = 0.5 * eta_t * a * a;
+    const double mcrit = THREEPI_16 * a * mu_fcrit;
+
+    double angle = phi;
+    if (history_update) angle += magtwist * dt;
+
+    double moment = -k * angle - damp * magtwist;
+    if (fabs(moment) > mcrit) {
+      moment = (moment > 0.0) ? mcrit : -mcrit;
+      angle = (k > 0.0) ? -(moment + damp * magtwist) / k : 0.0;
+    }
+    if (history_update) phi = angle;
+    return moment;
+  }
+
+}    // namespace MarshallKernels
+}    // namespace LAMMPS_NS
+
+#endif

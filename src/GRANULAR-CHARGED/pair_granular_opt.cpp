@@ -1,0 +1,325 @@
+/* ----------------------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+#include "pair_granular_opt.h"
+
+#include "gran_sub_mod_damping_marshall.h"
+#include "gran_sub_mod_normal_jkr_marshall.h"
+#include "gran_sub_mod_rolling_marshall.h"
+#include "gran_sub_mod_tangential_marshall.h"
+#include "gran_sub_mod_twisting_marshall_jkr.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "fix.h"
+#include "fix_neigh_history.h"
+#include "force.h"
+#include "gran_sub_mod.h"
+#include "granular_model.h"
+#include "math_extra.h"
+#include "memory.h"
+#include "neigh_list.h"
+#include "neighbor.h"
+#include "update.h"
+
+#include <cmath>
+#include <cstring>
+
+using namespace LAMMPS_NS;
+using namespace Granular_NS;
+using namespace MathExtra;
+namespace MK = MarshallKernels;
+
+/* ---------------------------------------------------------------------- */
+
+PairGranularOpt::PairGranularOpt(LAMMPS *lmp) :
+    PairGranular(lmp), fused_ready(false), generic_only(true), hist_tangential(0), hist_rolling(0), hist_twisting(0)
+{
+}
+
+/* ---------------------------------------------------------------------- */
+
+void PairGranularOpt::init_style()
+{
+  PairGranular::init_style();
+  fused_ready = false;    // init_one() may still mix new models: set up before the first compute
+}
+
+/* ---------------------------------------------------------------------- */
+
+bool PairGranularOpt::model_is_fused(int n) const
+{
+  return fused_ready && !generic_only && n >= 0 && n < (int) fused.size() && fused[n].on;
+}
+
+/* ----------------------------------------------------------------------
+   which models the fused kernel covers: jkr/marshall + damping marshall or marshall/printed +
+   tangential marshall, rolling none | marshall | marshall/particle, twisting none |
+   marshall/jkr, heat none, without synchronized_verlet (LAMMPS 4Jul2026; limit_damping cannot
+   be used with a cohesive model). The history offsets are those PairGranular::init_style() gave
+   the sub-models: the same for every model.
+------------------------------------------------------------------------- */
+
+void PairGranularOpt::setup_fused()
+{
+  fused.assign(nmodels, FusedMarshall());
+  for (int n = 0; n < nmodels; n++) {
+    GranularModel *model = models_list[n];
+    auto *normal = dynamic_cast<GranSubModNormalJKRMarshall *>(model->normal_model);
+    auto *damping = dynamic_cast<GranSubModDampingMarshall *>(model->damping_model);
+    auto *tangential = dynamic_cast<GranSubModTangentialMarshall *>(model->tangential_model);
+    auto *rolling = dynamic_cast<GranSubModRollingMarshall *>(model->rolling_model);
+    auto *twisting = dynamic_cast<GranSubModTwistingMarshallJKR *>(model->twisting_model);
+    const bool rolling_ok = rolling || model->rolling_model->name == "none";
+    const bool twisting_ok = twisting || model->twisting_model->name == "none";
+    bool ok = normal && damping && tangential && rolling_ok && twisting_ok &&
+        model->sub_models[HEAT]->name == "none" && !model->limit_damping;
+#if GC_LAMMPS_VERSION >= 20260704
+    ok = ok && !model->synchronized_verlet;
+#endif
+    if (!ok) continue;
+
+    FusedMarshall &f = fused[n];
+    f.on = true;
+    f.emix = normal->get_emix();
+    f.gamma = normal->get_surface_energy();
+    f.alpha = damping->get_alpha();
+    f.mass_factor = damping->get_mass_factor();
+    f.k_t = tangential->get_k();
+    f.mu = tangential->get_mu();
+    f.rolling = rolling != nullptr;
+    if (rolling) {
+      f.theta_crit = rolling->get_theta_crit();
+      f.roll_radius_factor = rolling->get_pair_radius_factor();
+    }
+    f.twisting = twisting != nullptr;
+
+    hist_tangential = model->tangential_model->history_index;
+    hist_rolling = model->rolling_model->history_index;
+    hist_twisting = model->twisting_model->history_index;
+  }
+  // a heat model needs PairGranular's heat-flow bookkeeping, which the fused loop does not do
+  generic_only = true;
+  for (int n = 0; n < nmodels; n++)
+    if (fused[n].on) generic_only = false;
+  for (int n = 0; n < nmodels; n++)
+    if (models_list[n]->sub_models[HEAT]->name != "none") generic_only = true;
+  fused_ready = true;
+}
+
+/* ----------------------------------------------------------------------
+   PairGranular::compute() with the Marshall set fused. The generic branch is PairGranular's
+   loop body; the fused branch does what GranularModel::check_contact() and calculate_forces()
+   do with the Marshall sub-models, in the same order of operations, skipping what the set does
+   not use (relative tangential speed, heat, classic torque scaling). The history of a pair is
+   the same array at the same offsets, so fix neigh/history, restarts and single() see no
+   difference.
+------------------------------------------------------------------------- */
+
+void PairGranularOpt::compute(int eflag, int vflag)
+{
+  if (!fused_ready) setup_fused();
+
+  if (generic_only || fix_rigid) {
+    // nothing to fuse, a heat model, or rigid-body masses: the sub-model path does it all
+    PairGranular::compute(eflag, vflag);
+    return;
+  }
+
+  const bool history_update = update->setupflag == 0;
+  for (int n = 0; n < nmodels; n++) models_list[n]->history_update = history_update;
+
+  ev_init(eflag, vflag);
+
+  int *type = atom->type;
+  double **x = atom->x;
+  double **v = atom->v;
+  double **f = atom->f;
+  double **omega = atom->omega;
+  double **torque = atom->torque;
+  double *radius = atom->radius;
+  double *rmass = atom->rmass;
+  int *mask = atom->mask;
+  const int nlocal = atom->nlocal;
+  const int newton_pair = force->newton_pair;
+  double *special_lj = force->special_lj;
+  const int size_hist = get_size_history();
+
+  const int inum = list->inum;
+  int *ilist = list->ilist;
+  int *numneigh = list->numneigh;
+  int **firstneigh = list->firstneigh;
+  int **firsttouch = use_history ? fix_history->firstflag : nullptr;
+  double **firsthistory = use_history ? fix_history->firstvalue : nullptr;
+
+  for (int ii = 0; ii < inum; ii++) {
+    const int i = ilist[ii];
+    const int itype = type[i];
+    int *touch = use_history ? firsttouch[i] : nullptr;
+    double *allhistory = use_history ? firsthistory[i] : nullptr;
+    int *jlist = firstneigh[i];
+    const int jnum = numneigh[i];
+
+    for (int jj = 0; jj < jnum; jj++) {
+      int j = jlist[jj];
+      const double factor_lj = special_lj[sbmask(j)];
+      j &= NEIGHMASK;
+      if (factor_lj == 0) continue;
+
+      const int jtype = type[j];
+      const int imodel = types_indices[itype][jtype];
+      GranularModel *model = models_list[imodel];
+      double *history = use_history ? &allhistory[size_hist * jj] : nullptr;
+
+      double forces[3], torquesi[3], torquesj[3], dx[3];
+      if (fused[imodel].on) {
+        FusedMarshall &fm = fused[imodel];
+
+        // contact geometry and life (GranularModel::check_contact, jkr/marshall touch)
+        sub3(x[i], x[j], dx);
+        const double rsq = lensq3(dx);
+        const double radi = radius[i];
+        const double radj = radius[j];
+        const double radsum = radi + radj;
+        // most neighbors of a deposition do not touch: reject those before R_eff and the scales
+        // (their history is zero already: zeroed when the contact ended, or new from the list)
+        if (!touch[jj] && rsq >= radsum * radsum) continue;
+        const double reff = radi * radj / radsum;
+        MK::use_jkr_scales(fm.scales, reff, fm.gamma, fm.emix);
+        if (!MK::jkr_touch(touch[jj] != 0, rsq, radsum, fm.scales.deltac)) {
+          touch[jj] = 0;
+          for (int k = 0; k < size_hist; k++) history[k] = 0.0;
+          continue;
+        }
+        touch[jj] = 1;
+
+        double mi = rmass[i];
+        double mj = rmass[j];
+        double meff = mi * mj / (mi + mj);
+        if (mask[i] & freeze_group_bit) meff = mj;
+        if (mask[j] & freeze_group_bit) meff = mi;
+        const double dt = model->dt;
+
+        // kinematics (GranularModel::calculate_forces)
+        const double r = sqrt(rsq);
+        const double rinv = 1.0 / r;
+        const double delta = radsum - r;
+        double vr[3], nx[3], vn[3], vt[3], wr[3], temp[3], vtr[3];
+        sub3(v[i], v[j], vr);
+        scale3(rinv, dx, nx);
+        const double vnnr = dot3(vr, nx);
+        scale3(vnnr, nx, vn);
+        sub3(vr, vn, vt);
+        scaleadd3(radi, omega[i], radj, omega[j], wr);
+        cross3(wr, nx, temp);
+        sub3(vt, temp, vtr);
+
+        // normal: JKR with Marshall damping
+        const MK::NormalForce nf = MK::jkr_normal_force(fm.scales, fm.gamma, fm.emix, delta, reff);
+        const double damp_prefactor =
+            MK::damping_prefactor(fm.alpha, fm.mass_factor, meff, fm.emix, nf.a);
+        const double fntot = nf.fne + (-damp_prefactor * vnnr);
+        const double fncrit = MK::critical_force(nf);
+
+        // sliding
+        double fs[3];
+        MK::tangential_force(&history[hist_tangential], nx, vtr, dt, fm.k_t * nf.a,
+                             damp_prefactor, fncrit * fm.mu, history_update, fs);
+
+        scale3(fntot, nx, forces);
+        add3(forces, fs, forces);
+        cross3(nx, fs, torquesi);
+        scale3(-1, torquesi);
+        copy3(torquesi, torquesj);
+        scale3(radi - 0.5 * delta, torquesi);
+        scale3(radj - 0.5 * delta, torquesj);
+
+        if (fm.rolling || fm.twisting) {
+          double relrot[3];
+          sub3(omega[i], omega[j], relrot);
+          if (fm.rolling) {
+            // rolling velocity, eq. 31 of Wang et al, Particuology 23, 49 (2015)
+            double vrl[3], fr[3], torroll[3];
+            vrl[0] = reff * (relrot[1] * nx[2] - relrot[2] * nx[1]);
+            vrl[1] = reff * (relrot[2] * nx[0] - relrot[0] * nx[2]);
+            vrl[2] = reff * (relrot[0] * nx[1] - relrot[1] * nx[0]);
+            MK::rolling_force(&history[hist_rolling], nx, vrl, dt,
+                              fm.theta_crit * (fm.roll_radius_factor * reff), nf.adhesive / reff,
+                              history_update, fr);
+            cross3(nx, fr, torroll);
+            scale3(reff, torroll);
+            add3(torquesi, torroll, torquesi);
+            sub3(torquesj, torroll, torquesj);
+          }
+          if (fm.twisting) {
+            // omega_T (eq. 29 of Marshall 2009)
+            const double magtwist = dot3(relrot, nx);
+            const double moment = MK::twisting_moment(history[hist_twisting], magtwist, dt, nf.a,
+                                                      fm.k_t, damp_prefactor, fm.mu * fncrit,
+                                                      history_update);
+            double tortwist[3];
+            scale3(moment, nx, tortwist);
+            add3(torquesi, tortwist, torquesi);
+            sub3(torquesj, tortwist, torquesj);
+          }
+        }
+      } else {
+        // PairGranular's sub-model path for this pair
+        model->xi = x[i];
+        model->xj = x[j];
+        model->radi = radius[i];
+        model->radj = radius[j];
+        model->i = i;
+        model->j = j;
+        model->itype = itype;
+        model->jtype = jtype;
+        if (use_history) model->touch = touch[jj];
+        if (!model->check_contact()) {
+          if (use_history) {
+            touch[jj] = 0;
+            for (int k = 0; k < size_hist; k++) history[k] = 0.0;
+          }
+          continue;
+        }
+        if (use_history) touch[jj] = 1;
+
+        const double mi = rmass[i];
+        const double mj = rmass[j];
+        double meff = mi * mj / (mi + mj);
+        if (mask[i] & freeze_group_bit) meff = mj;
+        if (mask[j] & freeze_group_bit) meff = mi;
+        model->meff = meff;
+        model->vi = v[i];
+        model->vj = v[j];
+        model->omegai = omega[i];
+        model->omegaj = omega[j];
+        model->history = history;
+        model->calculate_forces();
+        copy3(model->forces, forces);
+        copy3(model->torquesi, torquesi);
+        copy3(model->torquesj, torquesj);
+        copy3(model->dx, dx);
+      }
+
+      // apply forces & torques
+      scale3(factor_lj, forces);
+      add3(f[i], forces, f[i]);
+      scale3(factor_lj, torquesi);
+      add3(torque[i], torquesi, torque[i]);
+      if (newton_pair || j < nlocal) {
+        sub3(f[j], forces, f[j]);
+        scale3(factor_lj, torquesj);
+        add3(torque[j], torquesj, torque[j]);
+      }
+      if (evflag)
+        ev_tally_xyz(i, j, nlocal, newton_pair, 0.0, 0.0, forces[0], forces[1], forces[2], dx[0],
+                     dx[1], dx[2]);
+    }
+  }
+}

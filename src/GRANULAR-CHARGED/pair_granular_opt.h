@@ -1,0 +1,68 @@
+/* -*- c++ -*- ----------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+#ifdef PAIR_CLASS
+// clang-format off
+PairStyle(granular/opt,PairGranularOpt);
+// clang-format on
+#else
+
+#ifndef LMP_PAIR_GRANULAR_OPT_H
+#define LMP_PAIR_GRANULAR_OPT_H
+
+#include "marshall_kernels.h"
+#include "pair_granular.h"
+
+#include <vector>
+
+namespace LAMMPS_NS {
+
+// pair_style granular with a fused kernel for the Marshall sub-model set (jkr/marshall,
+// damping marshall[/printed], tangential marshall, optional rolling marshall[/particle] and
+// twisting marshall/jkr): one pass per neighbor pair through the inline equations of
+// marshall_kernels.h, no virtual calls. Every other type pair runs PairGranular's sub-model
+// path. Same pair_coeff syntax, history layout, restart and single() as granular
+// (doc/pair_granular_jkr_marshall.md, "pair_style granular/opt").
+class PairGranularOpt : public PairGranular {
+ public:
+  PairGranularOpt(class LAMMPS *);
+  void compute(int, int) override;
+  void init_style() override;
+
+  // for tests and the log: does model n run the fused kernel?
+  bool model_is_fused(int n) const;
+
+ protected:
+  // coefficients of one model for the fused kernel, copied from its sub-models
+  struct FusedMarshall {
+    bool on = false;                  // the model is of the fused set
+    double emix = 0.0;                // E*
+    double gamma = 0.0;               // surface energy
+    double alpha = 0.0;               // damping alpha(e)
+    double mass_factor = 2.0;         // damping marshall 2, marshall/printed 1
+    double k_t = 0.0;                 // 8 G*: tangential stiffness per unit contact radius
+    double mu = 0.0;                  // sliding friction coefficient
+    bool rolling = false;             // rolling marshall[/particle] defined
+    double theta_crit = 0.0;          // critical rolling angle
+    double roll_radius_factor = 1.0;  // rolling limit at theta_crit x this x R_eff
+    bool twisting = false;            // twisting marshall/jkr defined
+    MarshallKernels::JKRScales scales;    // delta_C, a_sep, F_C of the last R_eff
+  };
+  std::vector<FusedMarshall> fused;      // one per entry of models_list
+  bool fused_ready;                      // false after init_style(): rebuild before compute()
+  bool generic_only;                     // no model fused (or a heat model): PairGranular's path
+  int hist_tangential, hist_rolling, hist_twisting;    // offsets in the per-pair history
+
+  void setup_fused();
+};
+
+}    // namespace LAMMPS_NS
+
+#endif
+#endif
