@@ -5,12 +5,14 @@
 #                                  20260704 (default, 4Jul2026, sid) or 20250204 (4Feb2025, trixie),
 #                                  into GC_DEPS_DIR (default <repo>/.deps), sha256-checked
 # Result: GC_LAMMPS_DIR, GC_LAMMPS_VERSION (yyyymmdd of the tree) and the compatibility
-# definitions GC_LAMMPS_COMPILE_DEFINITIONS for the package sources (doc/build.md, "Releases").
+# definitions GC_LAMMPS_COMPILE_DEFINITIONS for the package sources (doc/build.md, "Releases"),
+# GC_GRAN_SUB_MOD_MECHANISM (style-header or table, cmake/GranSubModRegistry.cmake).
 set(GC_SUPPORTED_LAMMPS_VERSIONS 20250204 20260704)    # oldest first, both tested by .ci/run
 set(GC_SUPPORTED_LAMMPS_NAMES "4Feb2025 (20250204) and 4Jul2026 (20260704)")
 set(LAMMPS_SOURCE_DIR "" CACHE PATH "Root of a LAMMPS checkout (4Feb2025 to 4Jul2026); empty = Debian source package")
 set(LAMMPS_VERSION 20260704 CACHE STRING "LAMMPS release fetched from Debian when LAMMPS_SOURCE_DIR is empty")
 set_property(CACHE LAMMPS_VERSION PROPERTY STRINGS ${GC_SUPPORTED_LAMMPS_VERSIONS})
+include(GranSubModRegistry)
 set(GC_DEPS_DIR "${CMAKE_CURRENT_SOURCE_DIR}/.deps" CACHE PATH "Cache folder for the downloaded LAMMPS source")
 
 # Checks a tree before anything is built from it: complete, a supported release, and a
@@ -34,30 +36,27 @@ function(gc_check_lammps_tree dir origin)
   math(EXPR ver "${CMAKE_MATCH_3} * 10000 + (${mon} + 1) * 100 + ${CMAKE_MATCH_1}")
   list(GET GC_SUPPORTED_LAMMPS_VERSIONS 0 oldest)
   list(GET GC_SUPPORTED_LAMMPS_VERSIONS -1 newest)
-  if(ver LESS oldest OR ver GREATER newest)
+  if(ver LESS oldest)
     message(FATAL_ERROR "LAMMPS in ${dir} (${origin}) is version ${ver}, outside the supported range ${oldest} to ${newest}.\n${hint}")
   endif()
-  if(NOT ver IN_LIST GC_SUPPORTED_LAMMPS_VERSIONS)
+  if(ver GREATER newest)
+    # the next release (sub-model table, see below) is prepared for but not yet tested
+    message(WARNING "LAMMPS version ${ver} is newer than the newest tested release (${GC_SUPPORTED_LAMMPS_NAMES}); building it untested.")
+  elseif(NOT ver IN_LIST GC_SUPPORTED_LAMMPS_VERSIONS)
     message(WARNING "LAMMPS version ${ver} lies between the supported releases but is not itself tested (${GC_SUPPORTED_LAMMPS_NAMES}).")
   endif()
 
-  # The overlay adds its gran_sub_mod_*.h headers through RegisterStyles(), which only works
-  # while LAMMPS builds its sub-model table from the generated style_gran_sub_mod.h. Upstream
-  # development is replacing that with a hand-edited table (gran_sub_mod_register.cpp).
-  file(STRINGS "${dir}/cmake/Modules/StyleHeaderUtils.cmake" reg REGEX "GRAN_SUB_MOD_CLASS")
-  file(STRINGS "${dir}/src/GRANULAR/granular_model.cpp" inc REGEX "#include \"style_gran_sub_mod.h\"")
-  if(EXISTS "${dir}/src/GRANULAR/gran_sub_mod_register.cpp")
-    set(found "a hand-edited sub-model table, src/GRANULAR/gran_sub_mod_register.cpp")
-  elseif(NOT reg)
-    set(found "StyleHeaderUtils.cmake without GRAN_SUB_MOD_CLASS headers")
-  elseif(NOT inc)
-    set(found "granular_model.cpp without #include \"style_gran_sub_mod.h\"")
-  endif()
-  if(found)
+  # How the tree registers granular sub-models (cmake/GranSubModRegistry.cmake): the generated
+  # style_gran_sub_mod.h (4Feb2025, 4Jul2026: RegisterStyles() adds the package's headers) or
+  # the checked-in table gran_sub_mod_register.cpp (development branch: the build compiles a
+  # copy with the package's rows instead).
+  gc_gran_sub_mod_mechanism("${dir}" mech)
+  if(NOT mech)
     message(FATAL_ERROR "LAMMPS in ${dir} (${origin}, version ${ver}) does not register granular "
-      "sub-models through the generated style_gran_sub_mod.h; found ${found}. "
-      "GRANULAR-CHARGED adds its sub-models through that header and cannot overlay this tree.\n${hint}")
+      "sub-models in a way GRANULAR-CHARGED knows (the generated style_gran_sub_mod.h or the table "
+      "src/GRANULAR/gran_sub_mod_register.cpp); found ${mech_WHY}.\n${hint}")
   endif()
+  set(GC_GRAN_SUB_MOD_MECHANISM ${mech} PARENT_SCOPE)
 
   # Compatibility points (one source for both releases): 4Jul2026 changed
   # GranSubModTwisting::calculate_forces() to return the twisting moment instead of storing it.
