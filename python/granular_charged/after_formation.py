@@ -12,8 +12,17 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from . import tables
-from .params import coulomb_to_adhesion
-from .runner import RunError, Runner, read_result, write_json
+from .deckfile import deck_variables
+from .params import ParamError, coulomb_to_adhesion
+from .runner import RunError, Runner, folder_lock, read_result, write_json
+
+DECK = "in.charged-after-formation"
+# the variables of a Table 2 run that are not the formed packing's: where it starts from, the
+# charge it is given, and its folder
+OWN = {"restart": "the formed packing's final.restart", "q_after": "the Table 2 charges",
+       "out": "the Table 2 run's folder"}
+# what table2_frame and the figures read of a Table 2 run's result.json
+ROW_KEYS = ("q", "phi_before", "phi_after", "Z_before", "Z_after", "FC_over_FE", "wall_s")
 
 log = logging.getLogger(__name__)
 
@@ -22,7 +31,14 @@ def run_table2(runner: Runner, formed: Path, qs, out: Path, extra: dict | None =
                jobs: int = 1) -> list[dict]:
     """One charged-after-formation run per charge in out/q<q>/ (resumable; up to `jobs` at a
     time); writes out/table2.csv (ours beside the paper's Table 2) and returns the rows in the
-    order of qs."""
+    order of qs. Each run takes the formed run's parameters and every deck variable of it that
+    in.charged-after-formation also has (the contact models, the Coulomb solver's settings, the
+    slab), then `extra` (variables of that deck)."""
+    deck = deck_variables(DECK)
+    for k in extra or {}:
+        if k in OWN or k not in deck:
+            raise ParamError(f"{DECK}: {k!r} is not a variable a Table 2 run takes"
+                             + (f" ({OWN[k]} sets it)" if k in OWN else ""))
     formed = Path(formed).resolve()
     res_formed = read_result(formed / "result.json")
     if res_formed is None:
@@ -35,20 +51,23 @@ def run_table2(runner: Runner, formed: Path, qs, out: Path, extra: dict | None =
 
     def one(q) -> dict:
         wd = out / f"q{q:g}"
+        with folder_lock(out / f".{wd.name}.lock", f"table 2, q = {q:g}"):
+            return run_one(q, wd)
+
+    def run_one(q, wd) -> dict:
         rf = wd / "result.json"
-        if rf.exists():
-            try:
-                r = json.loads(rf.read_text())
+        try:
+            r = json.loads(rf.read_text())
+            if isinstance(r, dict) and all(k in r for k in ROW_KEYS):
                 r["dir"] = str(wd)
                 log.debug("table 2, q = %g: finished before", q)
                 return r
-            except ValueError:
-                pass
-        v = {k: p[k] for k in ("rp", "U0", "gamma", "rho", "E", "nu", "e", "mu", "theta_crit")}
+            log.info("table 2, q = %g: %s is incomplete, running it again", q, rf)
+        except (OSError, ValueError):
+            pass
+        formed_vars = {k: v for k, v in p.items() if k != "extra"} | p.get("extra", {})
+        v = {k: x for k, x in formed_vars.items() if k in deck and k not in OWN}
         v.update({"restart": str(formed / "final.restart"), "q_after": q, "out": "."})
-        for k in ("zlo_rp", "top_rp"):
-            if k in p.get("extra", {}):
-                v[k] = p["extra"][k]
         v.update(extra or {})
         lmp = runner.run_deck("in.charged-after-formation", wd, {k: str(x) for k, x in v.items()},
                               kind="after")
@@ -70,28 +89,21 @@ def run_table2(runner: Runner, formed: Path, qs, out: Path, extra: dict | None =
     return rows
 
 
-def main(argv=None) -> int:
-    """python3 -m granular_charged.after_formation --formed RUN_DIR --q ... --out DIR"""
-    import argparse
 
-    from .cli import setup_logging
-    from .lammps_build import LammpsBuild
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--formed", required=True, help="run folder of a neutral deposition")
-    ap.add_argument("--q", type=float, nargs="+", default=[0.0, 260.0, 400.0])
-    ap.add_argument("--out", required=True)
-    ap.add_argument("--build-dir", default=None)
-    ap.add_argument("--np", type=int, default=1)
-    ap.add_argument("--jobs", type=int, default=1, help="runs at a time")
-    ap.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"))
-    a = ap.parse_args(argv)
-    setup_logging(0, 0)
-    runner = Runner(LammpsBuild.find(a.build_dir), np_ranks=a.np)
-    rows = run_table2(runner, Path(a.formed), a.q, Path(a.out), dict(a.var), jobs=a.jobs)
-    print(tables.format_table(tables.table2_frame(rows), "{:.5g}"))
-    return 0
-
-
-if __name__ == "__main__":
-    import sys
-    sys.exit(main())
+def load_table2(folder: Path) -> list[dict]:
+    """The finished Table 2 runs under folder/q*/ (with 'dir'); unreadable or incomplete ones
+    are named in a warning and left out."""
+    rows = []
+    for f in sorted(Path(folder).glob("q*/result.json")):
+        try:
+            r = json.loads(f.read_text())
+        except (OSError, ValueError) as e:
+            log.warning("%s: not valid JSON (%s), ignored", f, e)
+            continue
+        missing = [k for k in ROW_KEYS if not isinstance(r, dict) or k not in r]
+        if missing:
+            log.warning("%s: keys missing: %s, ignored", f, ", ".join(missing))
+            continue
+        r["dir"] = str(f.parent)
+        rows.append(r)
+    return rows

@@ -12,6 +12,7 @@ import json
 import math
 import os
 import sys
+import threading
 
 from .paper import Z_COLORS
 
@@ -96,7 +97,40 @@ def render(lmp, path: str, rp: float):
         f"amap -0.5 {nz - 0.5} sa 1 {nz} {names}")
 
 
+def _start_time(pid: int) -> str | None:
+    """The start time of process pid (field 22 of /proc/PID/stat), None if it is gone or a
+    zombie: with the pid it names one process, even if the pid is reused later."""
+    try:
+        stat = open(f"/proc/{pid}/stat").read()
+    except OSError:
+        return None
+    fields = stat[stat.rindex(")") + 2:].split()   # after "pid (comm) "
+    return None if fields[0] in "ZX" else fields[19]
+
+
+def watch_parent(pid: int, interval: float = 0.5):
+    """Exit this process when the runner process pid has died (e.g. kill -9, which it cannot
+    pass on): a watcher thread polls it, since LAMMPS holds the main thread in C. The pid comes
+    from the runner (runner.PARENT_ENV) and not from getppid(): under mpirun the ranks' parent
+    is mpirun, which outlives the runner. os._exit: no clean-up that could wait on LAMMPS; the
+    run's folder has no result.json and is run again next time. mpirun ends when its ranks
+    have."""
+    born = _start_time(pid)
+    if born is None:
+        os._exit(3)
+
+    def poll():
+        import time
+        while _start_time(pid) == born:
+            time.sleep(interval)
+        os._exit(3)
+
+    threading.Thread(target=poll, name="gc-parent-watch", daemon=True).start()
+
+
 def main(argv=None) -> int:
+    if os.environ.get("GC_PARENT_PID"):
+        watch_parent(int(os.environ["GC_PARENT_PID"]))
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("deck")
     ap.add_argument("workdir")

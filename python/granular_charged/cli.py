@@ -7,12 +7,12 @@ its claims not yet covered). ``-v``/``-q`` set the log level; ``--build-dir`` th
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 import sys
 from pathlib import Path
 
 from . import __version__
+from .logs import setup_logging
 
 log = logging.getLogger("granular_charged")
 
@@ -32,6 +32,17 @@ U_0 = 0.5, 0.707, 1.414, 2 m/s, gamma = 5, 20 mJ/m^2 and r_p = 1 um (phi and <Z>
 collapse of the charged cases quantified; the paper's Fig. 9), and the Table 2 check. N = 500
 in L = 14 r_p, or with --quick N = 200 in L = 9 r_p and five charges (the paper's particles per floor area),
 three seeds, one particle per r_p of fall (doc/deposition.md)."""
+
+
+def _count(text: str) -> int:
+    """argparse type: a whole number >= 1 (particles, ranks, jobs)."""
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, not {v}")
+    return v
 
 
 def _common() -> argparse.ArgumentParser:
@@ -58,10 +69,12 @@ def _deck_options(p: argparse.ArgumentParser, many: bool):
                    help="surface energy [J/m^2]")
     p.add_argument("--q", type=float, nargs=nargs, default=[0.0] if many else 0.0,
                    help="charge per particle [e0]")
-    p.add_argument("--N", type=int, default=2000, help="particles to inject")
-    p.add_argument("--np", type=int, default=1, help="MPI ranks per run (mpirun)")
+    p.add_argument("--N", type=_count, default=2000, help="particles to inject")
+    p.add_argument("--np", type=_count, default=1, help="MPI ranks per run (mpirun)")
     p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
-                   help="any other deck variable, e.g. --var L_rp 14 --var farfield average")
+                   help="any other variable of the deck (its 'variable NAME index' lines), e.g. "
+                        "--var L_rp 14 --var farfield average; not those with an option of "
+                        "their own (--rp --U0 --gamma --q --N --seed --tracer)")
     p.add_argument("--tracer", type=int, default=0, help="follow this particle id (Fig. 8)")
     p.add_argument("--no-render", action="store_true", help="no rendered packing image")
 
@@ -83,7 +96,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "OUT/<key>/ and write result.json there; a finished run is "
                                    "not run again unless --force.")
     p.add_argument("--out", default="runs", help="parent folder of the run folder (default runs)")
-    p.add_argument("--seed", type=int, default=4711)
+    p.add_argument("--seed", type=_count, default=4711)
     p.add_argument("--force", action="store_true", help="run again even if finished")
     _deck_options(p, many=False)
 
@@ -93,9 +106,9 @@ def build_parser() -> argparse.ArgumentParser:
                                    "interrupted sweep resumes where it stopped.")
     p.add_argument("--out", required=True, help="results folder (one sub-folder per run)")
     p.add_argument("--preset", choices=["paper"], help="the paper's full set of cases")
-    p.add_argument("--seeds", type=int, nargs="+", default=[4711],
+    p.add_argument("--seeds", type=_count, nargs="+", default=[4711],
                    help="seeds of the injection positions (default 4711)")
-    p.add_argument("--jobs", type=int, default=1, help="runs at a time")
+    p.add_argument("--jobs", type=_count, default=1, help="runs at a time")
     p.add_argument("--figures", default=None, metavar="DIR", help="then draw the figures here")
     _deck_options(p, many=True)
 
@@ -107,6 +120,23 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="folder for the figures")
     p.add_argument("--table2", default=None, metavar="DIR",
                    help="a folder of charged-after-formation runs (demo-output/table2)")
+
+    p = sub.add_parser("table2", parents=[common],
+                       help="the Table 2 check on a finished neutral run",
+                       description="Charge a formed neutral packing (a finished run folder of "
+                                   "'run' or 'sweep') after its formation and relax it (the "
+                                   "package's in.charged-after-formation deck), one folder per "
+                                   "charge under --out, and write table2.csv beside the paper's "
+                                   "Table 2. Resumable.")
+    p.add_argument("formed", help="run folder of a finished neutral deposition")
+    p.add_argument("--q", type=float, nargs="+", default=[0.0, 260.0, 400.0],
+                   help="charges [e0] given after formation (default 0 260 400; 0: the control)")
+    p.add_argument("--out", required=True, help="folder of the Table 2 runs")
+    p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
+                   help="a variable of in.charged-after-formation for every run (the formed "
+                        "run's own settings are taken over), e.g. --var relax_rp 50")
+    p.add_argument("--jobs", type=_count, default=1, help="runs at a time")
+    p.add_argument("--np", type=_count, default=1, help="MPI ranks per run")
 
     p = sub.add_parser("reproduce", parents=[common],
                        help="the paper's scaling claims at reduced size: q^2 law, Ad* collapse, "
@@ -123,7 +153,7 @@ def build_parser() -> argparse.ArgumentParser:
                        description=DEMO_DESCRIPTION,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     _study_options(p, "demo", "deck variables besides the demo's L_rp 14, inject rain, gap_rp 1")
-    p.add_argument("--N", type=int, default=500, help="particles per run (default 500)")
+    p.add_argument("--N", type=_count, default=500, help="particles per run (default 500)")
     p.add_argument("--q", type=float, nargs="+", default=[0.0, 260.0, 400.0],
                    help="charges [e0] (default 0 260 400)")
     p.add_argument("--table2-q", type=float, nargs="*", default=[0.0, 260.0, 400.0],
@@ -138,24 +168,49 @@ def build_parser() -> argparse.ArgumentParser:
 def _study_options(p: argparse.ArgumentParser, name: str, var_help: str):
     """Options that demo and reproduce share."""
     p.add_argument("--out", default=f"{name}-output", help=f"output folder (default {name}-output)")
-    p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3],
+    p.add_argument("--seeds", type=_count, nargs="+", default=[1, 2, 3],
                    help="seeds of the injection positions (default 1 2 3)")
     p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
                    help=var_help)
-    p.add_argument("--jobs", type=int, default=1, help="runs at a time")
-    p.add_argument("--np", type=int, default=1, help="MPI ranks per run")
+    p.add_argument("--jobs", type=_count, default=1, help="runs at a time")
+    p.add_argument("--np", type=_count, default=1, help="MPI ranks per run")
     p.add_argument("--no-render", action="store_true", help="no rendered packing images")
 
 
-def setup_logging(verbose: int, quiet: int):
-    level = logging.INFO - 10 * verbose + 10 * quiet
-    handler = logging.StreamHandler(sys.stderr)
-    handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(message)s"
-                                           if verbose else "%(message)s", "%H:%M:%S"))
-    root = logging.getLogger("granular_charged")
-    root.handlers[:] = [handler]
-    root.setLevel(max(logging.DEBUG, level))
-    root.propagate = False
+# --var names that something else sets, per command: {name: what sets it}
+_OWN = {"rp": "use --rp", "U0": "use --U0", "gamma": "use --gamma", "q": "use --q",
+        "N": "use --N"}
+
+
+def _refused(command: str) -> dict:
+    from .runner import RESERVED
+    own = dict(_OWN, seed="use --seed" if command == "run" else "use --seeds")
+    if command == "reproduce":
+        # the study's cases set these; N by its size
+        own.update({k: "reproduce sets it per case" for k in ("rp", "U0", "gamma", "q")},
+                   N="reproduce sets it (500, or 200 with --quick)")
+    if command in ("demo", "reproduce"):
+        own["tracer"] = "use --tracer" if command == "demo" else "reproduce follows none"
+    return dict(RESERVED, **own)
+
+
+def _vars(a, command: str) -> tuple[dict, dict]:
+    """--var pairs checked against the deck that will run: (DepositionParams fields, extra)."""
+    from .deckfile import deck_variables
+    from .params import split_deck_vars
+    return split_deck_vars(a.var, deck_variables("in.deposition"), _refused(command))
+
+
+def _out_dir(path, option="--out") -> Path:
+    """An output folder: may exist as a folder, never as a file (ParamError before any run)."""
+    from .params import ParamError
+    p = Path(path)
+    for q in (p, *p.parents):
+        if q.exists():
+            if not q.is_dir():
+                raise ParamError(f"{option} {path}: {q} is a file, not a folder")
+            break
+    return p
 
 
 def _runner(a, render=True):
@@ -167,14 +222,17 @@ def _runner(a, render=True):
 
 def cmd_run(a) -> int:
     from .params import DepositionParams
-    from .runner import RunError
+    from .runner import RunError, Runner
     from .sweep import fmt
-    runner = _runner(a, not a.no_render)
+    fields, extra = _vars(a, "run")
     p = DepositionParams(rp=a.rp, U0=a.U0, gamma=a.gamma, q=a.q, N=a.N, seed=a.seed,
-                         extra={k: v for k, v in a.var})
-    log.info("run %s in %s (LAMMPS build %s)", p.key(), Path(a.out).resolve(), runner.build.path)
+                         extra=extra, **fields)
+    Runner.check(p, a.tracer)
+    out = _out_dir(a.out)
+    runner = _runner(a, not a.no_render)
+    log.info("run %s in %s (LAMMPS build %s)", p.key(), out.resolve(), runner.build.path)
     try:
-        r = runner.deposition(p, Path(a.out), force=a.force, tracer=a.tracer)
+        r = runner.deposition(p, out, force=a.force, tracer=a.tracer)
     except RunError as e:
         log.error("%s", e)
         return 1
@@ -186,31 +244,32 @@ def cmd_run(a) -> int:
 
 
 def cmd_sweep(a) -> int:
+    from .runner import Runner
     from .sweep import PAPER_SETS, Sweep, expand, load_results
-    runner = _runner(a, not a.no_render)
-    extra = {k: v for k, v in a.var}
+    fields, extra = _vars(a, "sweep")
     sets = PAPER_SETS if a.preset == "paper" else [dict(rp=a.rp, U0=a.U0, gamma=a.gamma, q=a.q)]
-    params = expand(sets, a.N, a.seeds, extra)
+    params = expand(sets, a.N, a.seeds, extra, fields)
+    for p in params:
+        Runner.check(p, a.tracer)
+    out = _out_dir(a.out)
+    figs = _out_dir(a.figures, "--figures") if a.figures else None
+    runner = _runner(a, not a.no_render)
     if not runner.build.capabilities["coul/fmm"]:
         skip = [p for p in params if p.q]
         if skip:
             log.warning("%d charged runs NOT run: fix coul/fmm is absent from %s", len(skip),
                         runner.build.path)
         params = [p for p in params if not p.q]
-    res = Sweep(runner, Path(a.out), jobs=a.jobs, progress=a.progress).run(params, a.tracer)
-    if a.figures:
-        _figures(load_results(Path(a.out)), Path(a.figures), None)
+    res = Sweep(runner, out, jobs=a.jobs, progress=a.progress).run(params, a.tracer)
+    if figs is not None:
+        _figures(load_results(out), figs, None)
     return 0 if len(res) == len(params) else 1
 
 
 def _figures(results, out: Path, t2dir: Path | None):
     from . import figures, tables
-    rows = []
-    if t2dir is not None:
-        for f in sorted(Path(t2dir).glob("q*/result.json")):
-            r = json.loads(f.read_text())
-            r["dir"] = str(f.parent)
-            rows.append(r)
+    from .after_formation import load_table2
+    rows = load_table2(t2dir) if t2dir is not None else []
     out.mkdir(parents=True, exist_ok=True)
     if results:
         s = tables.summary(tables.runs_frame(results))
@@ -224,38 +283,59 @@ def _figures(results, out: Path, t2dir: Path | None):
 
 def cmd_figures(a) -> int:
     from .sweep import load_results
+    out = _out_dir(a.out)
     results = load_results(Path(a.results))
     if not results:
         log.error("no finished runs (*/result.json) in %s", a.results)
         return 1
-    _figures(results, Path(a.out), Path(a.table2) if a.table2 else None)
+    _figures(results, out, Path(a.table2) if a.table2 else None)
+    return 0
+
+
+def cmd_table2(a) -> int:
+    from . import tables
+    from .after_formation import DECK, OWN, run_table2
+    from .deckfile import deck_variables
+    from .params import split_deck_vars
+    _, extra = split_deck_vars(a.var, deck_variables(DECK), OWN, DECK)
+    out = _out_dir(a.out)
+    rows = run_table2(_runner(a), Path(a.formed), a.q, out, extra, jobs=a.jobs)
+    print(tables.format_table(tables.table2_frame(rows), "{:.5g}"))
     return 0
 
 
 def cmd_reproduce(a) -> int:
     from .reproduce import Reproduction, report
-    runner = _runner(a, not a.no_render)
-    study = Reproduction(out=Path(a.out), quick=a.quick, seeds=tuple(a.seeds),
-                         extra={k: v for k, v in a.var}, jobs=a.jobs, progress=a.progress)
-    res = study.run(runner)
+    from .runner import Runner
+    fields, extra = _vars(a, "reproduce")
+    study = Reproduction(out=_out_dir(a.out), quick=a.quick, seeds=tuple(a.seeds), extra=extra,
+                         fields=fields, jobs=a.jobs, progress=a.progress)
+    for p in study.params(True):
+        Runner.check(p, study.tracer(p))
+    res = study.run(_runner(a, not a.no_render))
     print(report(res, study))
     return 0 if res["complete"] else 1
 
 
-def cmd_demo(a, reproduce=False) -> int:
-    from .demo import DEMO_VARS, Study, claims_report, report
-    runner = _runner(a, not a.no_render)
-    extra = dict(DEMO_VARS)
-    extra.update({k: v for k, v in a.var})
-    study = Study(out=Path(a.out), N=a.N, qs=tuple(a.q), seeds=tuple(a.seeds),
-                  table2_qs=tuple(a.table2_q), extra=extra, jobs=a.jobs, progress=a.progress,
-                  tracer=a.tracer)
-    res = study.run(runner)
+def cmd_demo(a) -> int:
+    from .demo import DEMO_VARS, Demo, claims_report, report
+    from .runner import Runner
+    fields, extra = _vars(a, "demo")
+    study = Demo(out=_out_dir(a.out), N=a.N, qs=tuple(a.q), seeds=tuple(a.seeds),
+                 table2_qs=tuple(a.table2_q), extra={**DEMO_VARS, **extra}, fields=fields,
+                 jobs=a.jobs, progress=a.progress, follow=a.tracer)
+    for p in study.params(True):
+        Runner.check(p, study.tracer(p))
+    res = study.run(_runner(a, not a.no_render))
     print(report(res, study))
-    if reproduce:
+    if a.claims:
         print()
         print(claims_report(res))
     return 0 if res["complete"] else 1
+
+
+COMMANDS = {"run": cmd_run, "sweep": cmd_sweep, "figures": cmd_figures, "table2": cmd_table2,
+            "reproduce": cmd_reproduce, "demo": cmd_demo}
 
 
 def main(argv=None) -> int:
@@ -264,23 +344,24 @@ def main(argv=None) -> int:
     setup_logging(verbose, quiet)
     a.progress = quiet == 0 and sys.stderr.isatty()
     from .lammps_build import BuildError
+    from .params import ParamError
+    from .runner import RunError
     try:
-        if a.command == "run":
-            return cmd_run(a)
-        if a.command == "sweep":
-            return cmd_sweep(a)
-        if a.command == "figures":
-            return cmd_figures(a)
-        if a.command == "reproduce":
-            return cmd_reproduce(a)
-        return cmd_demo(a, reproduce=a.claims)
+        return COMMANDS[a.command](a)
+    except ParamError as e:
+        # before any run: nothing was started or written
+        log.error("granular-charged %s: %s", a.command, e)
+        return 2
     except BuildError as e:
         log.error("%s", e)
         return 2
+    except RunError as e:
+        log.error("%s", e)
+        return 1
+    except OSError as e:
+        # a folder that cannot be made or written (permissions, a full disk, ...)
+        log.error("granular-charged %s: %s", a.command, e)
+        return 1
     except KeyboardInterrupt:
         log.error("interrupted: finished runs are kept; run the same command again to resume")
         return 130
-
-
-if __name__ == "__main__":
-    sys.exit(main())

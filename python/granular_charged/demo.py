@@ -10,19 +10,12 @@ the figures, all in one folder.
 """
 from __future__ import annotations
 
-import logging
-import time
 from dataclasses import dataclass, field
-from pathlib import Path
 from types import MappingProxyType
 
-from . import figures, paper, tables
-from .after_formation import run_table2
+from . import paper, tables
 from .params import DepositionParams
-from .runner import RunError, Runner
-from .sweep import Sweep
-
-log = logging.getLogger(__name__)
+from .study import Study
 
 # demo and reproduce: the rain from H at one particle per r_p for every charge: quick, and its
 # incident particles come from H (the tracer figure); charged packings are denser than the
@@ -34,57 +27,28 @@ FULL_COMMAND = ("granular-charged sweep --preset paper --N 2000 --seeds 1 2 3 "
 
 
 @dataclass
-class Study:
-    """A reduced study: depositions for each q and seed, the Table 2 check, tables, figures."""
-    out: Path
+class Demo(Study):
+    """The reduced Fig. 2 study: depositions for each q and seed, the Table 2 check, tables,
+    figures (the skeleton is :meth:`Study.run`)."""
     N: int = 500
     qs: tuple = (0.0, 260.0, 400.0)
-    seeds: tuple = (1, 2, 3)
-    table2_qs: tuple = (0.0, 260.0, 400.0)
     extra: dict = field(default_factory=lambda: dict(DEMO_VARS))
-    jobs: int = 1
-    progress: bool = True
-    tracer: int | None = None     # particle followed in the first seed's runs (None: N/2)
+    follow: int | None = None     # particle followed in the first seed's runs (None: N/2)
 
     def params(self, have_fmm: bool) -> list[DepositionParams]:
         qs = self.qs if have_fmm else [q for q in self.qs if q == 0]
-        return [DepositionParams(q=q, N=self.N, seed=s, extra=dict(self.extra))
+        return [DepositionParams(q=q, N=self.N, seed=s, extra=dict(self.extra),
+                                 **self.fields)
                 for q in qs for s in self.seeds]
 
-    def run(self, runner: Runner) -> dict:
-        t0 = time.monotonic()
-        out = Path(self.out).resolve()
-        have_fmm = runner.build.capabilities["coul/fmm"]
-        if not have_fmm:
-            log.warning("fix coul/fmm is NOT in this build: only the neutral case runs; the "
-                        "charged cases need fix coul/fmm (they are not faked)")
-        params = self.params(have_fmm)
-        first = self.seeds[0]
-        results = Sweep(runner, out / "runs", jobs=self.jobs, progress=self.progress).run(
-            params, tracer=lambda p: (self.tracer or self.N // 2) if p.seed == first else 0)
-        runs = tables.runs_frame(results)
-        summ = tables.summary(runs)
-        runs.drop(columns=["dir"]).to_csv(out / "runs.csv", index=False)
-        summ.to_csv(out / "summary.csv", index=False)
-        slopes = tables.expansion_slope(summ)
-        t2 = []
-        neutral = sorted((r for r in results if r["params"]["q"] == 0),
-                         key=lambda r: r["params"]["seed"])
-        if neutral and have_fmm and self.table2_qs:
-            try:
-                t2 = run_table2(runner, Path(neutral[0]["dir"]), self.table2_qs, out / "table2",
-                                {k: v for k, v in self.extra.items() if k.startswith("coul_")},
-                                jobs=self.jobs)
-            except RunError as e:
-                log.error("Table 2 check FAILED: %s", e)
-        figs = figures.all_figures(results, out / "figures", t2)
-        return {"out": out, "results": results, "runs": runs, "summary": summ,
-                "slopes": slopes, "table2": tables.table2_frame(t2) if t2 else None,
-                "figures": figs, "wall_s": time.monotonic() - t0, "complete":
-                len(results) == len(params), "have_fmm": have_fmm}
+    def tracer(self, p: DepositionParams) -> int:
+        return (self.follow or self.N // 2) if p.seed == self.seeds[0] else 0
+
+    def analyse(self, runs, summary, out) -> dict:
+        return {"slopes": tables.expansion_slope(summary)}
 
 
-def report(res: dict, study: Study) -> str:
+def report(res: dict, study: Demo) -> str:
     """The demo's printed summary."""
     s = res["summary"]
     lines = [
@@ -143,9 +107,3 @@ def claims_report(res: dict) -> str:
             for q, p, e in zip(ch["q"], ch["phi"], ch["expansion"])))
     return "\n".join(lines)
 
-
-if __name__ == "__main__":      # the older spelling, python3 -m granular_charged.demo ...
-    import sys
-
-    from .cli import main
-    sys.exit(main(["demo", *sys.argv[1:]]))

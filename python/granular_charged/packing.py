@@ -237,8 +237,10 @@ def rdf_slab(snap: Snapshot, zlo: float, zhi: float, rmax: float, nbins: int = 2
     return rc, g
 
 
-def analyse(snap: Snapshot, rp: float, zlo_rp=4.0, top_rp=6.0, tol=0.0) -> dict:
-    """phi, <Z>, f(Z) of the analysis slab of a final snapshot (the decks' rule)."""
+def analyse(snap: Snapshot, rp: float, zlo_rp=4.0, top_rp=6.0, tol=0.0,
+            zmax: int = ZMAX_DEFAULT) -> dict:
+    """phi, <Z>, f(Z) (zmax + 1 bins) of the analysis slab of a final snapshot (the decks'
+    rule)."""
     zlo, zhi = analysis_slab(snap, rp, zlo_rp, top_rp)
     out = {"zlo": zlo, "zhi": zhi, "slab_thickness_rp": (zhi - zlo) / rp}
     if zhi <= zlo:      # in.deposition's rule (slab_ok): a slab exists when zhi > zlo
@@ -246,6 +248,6 @@ def analyse(snap: Snapshot, rp: float, zlo_rp=4.0, top_rp=6.0, tol=0.0) -> dict:
                     "warning": "bed too thin for the analysis slab"})
         return out
     out["phi"] = phi_slab(snap, zlo, zhi)
-    cs = coordination_stats(snap, zlo, zhi, tol)
+    cs = coordination_stats(snap, zlo, zhi, tol, zmax)
     out.update({k: cs[k] for k in ("Z", "fZ", "n_slab")})
     return out

@@ -6,13 +6,25 @@ Marshall, J. Comput. Phys. 228 (2009) 1541. SI units throughout.
 """
 from __future__ import annotations
 
+import difflib
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields
+
+from .paper import K_EFF
 
 E0 = 1.602176634e-19        # elementary charge [C]
 EPS0 = 8.8541878128e-12     # vacuum permittivity [F/m]
 QQR2E_LAMMPS_SI = 8.9876e9  # LAMMPS's 'units si' Coulomb constant (doc/theory.md, eq. (3.1))
-K_EFF_PAPER = 51.0          # the paper's K_eff = 20 N_tot (L/r_p)^-2 with N_tot = 2000, L = 28 r_p
+
+
+class ParamError(ValueError):
+    """Parameters that cannot make a run; the message names the parameter and its bad value."""
+
+
+# Fields of DepositionParams without an option of their own on the command line: `--var NAME
+# VALUE` sets them as fields (typed), so that result.json's params, the groups and the key see
+# them. (As extra deck variables they reached LAMMPS while params kept the default.)
+MATERIAL = ("farfield", "rho", "E", "nu", "e", "mu", "theta_crit")
 
 
 @dataclass
@@ -33,6 +45,25 @@ class DepositionParams:
     theta_crit: float = 0.01
     extra: dict = field(default_factory=dict)   # any other deck variable (gap_rp, dt_div, ...)
 
+    def __post_init__(self):
+        own = sorted(set(self.extra) & set(param_names()))
+        if own:
+            raise ParamError(f"{', '.join(own)}: a parameter of its own "
+                             f"(DepositionParams({own[0]}=...)), not an extra deck variable")
+        # what the deck's arithmetic and LAMMPS's random seeds need; the physics of the other
+        # values is checked by the styles themselves (with LAMMPS errors naming them)
+        checks = (("N", self.N, self.N >= 1 and self.N == int(self.N), "a whole number >= 1"),
+                  ("seed", self.seed, self.seed >= 1 and self.seed == int(self.seed),
+                   "a whole number >= 1 (LAMMPS's random seeds are positive)"),
+                  ("rp", self.rp, self.rp > 0, "> 0 [m]"),
+                  ("U0", self.U0, self.U0 > 0, "> 0 [m/s] (the time step and the injection "
+                                               "interval divide by it)"),
+                  ("rho", self.rho, self.rho > 0, "> 0 [kg/m^3]"),
+                  ("q", self.q, math.isfinite(self.q), "a finite number [e0]"))
+        for name, value, ok, what in checks:
+            if not ok:
+                raise ParamError(f"{name} = {value:g}: must be {what}")
+
     def deck_vars(self) -> dict:
         d = asdict(self)
         extra = d.pop("extra")
@@ -40,13 +71,18 @@ class DepositionParams:
         return {k: str(v) for k, v in d.items()}
 
     def key(self) -> str:
-        """A file-system friendly name, unique for the swept parameters."""
+        """A file-system friendly name, unique for the parameters: the swept ones always, the
+        far field of a charged run, and every other one that differs from its default."""
         base = (f"rp{self.rp * 1e6:g}um_U{self.U0:g}_g{self.gamma * 1e3:g}mJ_q{self.q:g}"
                 f"_N{self.N}_s{self.seed}")
         if self.q:
             base += f"_{self.farfield}"
-        for k in sorted(self.extra):
-            base += f"_{k}{self.extra[k]}"
+        tags = {k: getattr(self, k) for k in MATERIAL
+                if k != "farfield" and getattr(self, k) != getattr(DepositionParams, k)}
+        tags.update(self.extra)
+        for k in sorted(tags):
+            v = tags[k]
+            base += f"_{k}{v:g}" if isinstance(v, float) else f"_{k}{v}"
         return base.replace("/", "-")
 
     # derived -------------------------------------------------------------------------------
@@ -65,6 +101,45 @@ class DepositionParams:
         d = dimensionless(self.gamma, self.rho, self.U0, self.rp, self.q, K_eff=K)
         d["K_eff"] = K
         return d
+
+
+def param_names() -> tuple:
+    """The fields of DepositionParams that are deck variables (all but `extra`)."""
+    return tuple(f.name for f in fields(DepositionParams) if f.name != "extra")
+
+
+def split_deck_vars(pairs, deck: dict, refused: dict, deck_name: str = "in.deposition"):
+    """``--var NAME VALUE`` pairs as (fields of DepositionParams, typed; other deck variables).
+
+    ``deck``: the variables of the deck that will run ({name: default}, see
+    deckfile.deck_variables); ``refused``: {name: what sets it instead} for names that have
+    their own option or are set by the runner. ParamError for a refused name, a name the deck
+    does not have (with the names it may have meant), a name given twice, and a field's value
+    that is not of the field's type."""
+    fields_, extra = {}, {}
+    seen = set()
+    for name, value in pairs:
+        if name in seen:
+            raise ParamError(f"--var {name}: given twice")
+        seen.add(name)
+        if name in refused:
+            raise ParamError(f"--var {name} {value}: {name} is not set with --var: "
+                             f"{refused[name]}")
+        if name not in deck:
+            near = difflib.get_close_matches(name, deck, n=3, cutoff=0.6)
+            near += [k for k in deck if k.lower() == name.lower() and k not in near]
+            hint = f" (did you mean {' or '.join(near)}?)" if near else ""
+            raise ParamError(f"--var {name} {value}: {deck_name} has no variable {name!r}{hint}; "
+                             f"--var sets: {', '.join(sorted(set(deck) - set(refused), key=str.lower))}")
+        if name in MATERIAL:
+            kind = type(getattr(DepositionParams, name))
+            try:
+                fields_[name] = kind(value)
+            except ValueError:
+                raise ParamError(f"--var {name} {value}: not a number") from None
+        else:
+            extra[name] = value
+    return fields_, extra
 
 
 def pair_modulus(E: float, nu: float) -> float:
@@ -119,7 +194,7 @@ def jkr_force_of_overlap(delta, R, Estar, gamma):
     return out * s["FC"]
 
 
-def dimensionless(gamma, rho, U0, rp, q_e0, K_eff=K_EFF_PAPER) -> dict:
+def dimensionless(gamma, rho, U0, rp, q_e0, K_eff=K_EFF) -> dict:
     """The paper's Sec. 4.2 groups.
 
     Ad = gamma / (rho U0^2 r_p)                              (dimensionless: J/m^2 / (kg/m^3 m^2/s^2 m))

@@ -18,21 +18,14 @@ this command; the paper-size rows from `sweep --N 2000`.
 from __future__ import annotations
 
 import json
-import logging
+from dataclasses import dataclass
 
 import numpy as np
-import time
-from dataclasses import dataclass, field
-from pathlib import Path
 
-from . import figures, paper, tables
-from .after_formation import run_table2
+from . import paper, tables
 from .demo import STUDY_INJECTION
 from .params import DepositionParams
-from .runner import RunError, Runner
-from .sweep import Sweep
-
-log = logging.getLogger(__name__)
+from .study import Study
 
 CHARGES = (0.0, 100.0, 200.0, 260.0, 300.0, 400.0, 450.0)
 QUICK_CHARGES = (0.0, 200.0, 300.0, 400.0, 450.0)      # --quick: fewer charges, same range
@@ -43,15 +36,10 @@ SIZES = {"full": {"N": 500, "L_rp": 14}, "quick": {"N": 200, "L_rp": 9}}
 
 
 @dataclass
-class Reproduction:
-    out: Path
+class Reproduction(Study):
+    """The paper's scaling claims at reduced size (the skeleton is :meth:`Study.run`)."""
     quick: bool = False
-    seeds: tuple = (1, 2, 3)
     charges: tuple = CHARGES
-    table2_qs: tuple = (0.0, 260.0, 400.0)
-    extra: dict = field(default_factory=dict)    # deck variables for every run
-    jobs: int = 1
-    progress: bool = True
 
     @property
     def size(self) -> dict:
@@ -61,45 +49,23 @@ class Reproduction:
         extra = {"L_rp": self.size["L_rp"], **STUDY_INJECTION, **self.extra}
         N = self.size["N"]
         charges = QUICK_CHARGES if self.quick else self.charges
-        ps = [DepositionParams(q=q, N=N, seed=s, extra=dict(extra))
+        ps = [DepositionParams(q=q, N=N, seed=s, extra=dict(extra), **self.fields)
               for q in charges if have_fmm or q == 0 for s in self.seeds]
-        ps += [DepositionParams(N=N, seed=s, extra=dict(extra), **case)
+        ps += [DepositionParams(N=N, seed=s, extra=dict(extra), **case, **self.fields)
                for case in NEUTRAL_CASES for s in self.seeds]
         return ps
 
-    def run(self, runner: Runner) -> dict:
-        t0 = time.monotonic()
-        out = Path(self.out).resolve()
-        have_fmm = runner.build.capabilities["coul/fmm"]
-        if not have_fmm:
-            log.warning("fix coul/fmm is NOT in this build: the charged cases are not run")
-        params = self.params(have_fmm)
-        results = Sweep(runner, out / "runs", jobs=self.jobs, progress=self.progress).run(params)
-        runs = tables.runs_frame(results)
-        summ = tables.summary(runs)
+    def table2_charges(self) -> tuple:
+        return (0.0, 400.0) if self.quick else tuple(self.table2_qs)
+
+    def analyse(self, runs, summary, out) -> dict:
         fit = tables.expansion_fit(runs)
         collapse = tables.adstar_collapse(runs)
         collapse_mid = tables.adstar_collapse(runs, barrier_fraction=0.5)
-        runs.drop(columns=["dir"]).to_csv(out / "runs.csv", index=False)
-        summ.to_csv(out / "summary.csv", index=False)
         collapse.to_csv(out / "collapse.csv", index=False)
         collapse_mid.to_csv(out / "collapse_mean_barrier.csv", index=False)
         (out / "expansion_fit.json").write_text(json.dumps(fit, indent=1))
-        t2 = []
-        neutral = sorted((r for r in results if r["params"]["q"] == 0 and
-                          r["params"]["U0"] == 1.0 and r["params"]["gamma"] == 0.01 and
-                          r["params"]["rp"] == 2e-6), key=lambda r: r["params"]["seed"])
-        table2_qs = (0.0, 400.0) if self.quick else self.table2_qs
-        if neutral and have_fmm and table2_qs:
-            try:
-                t2 = run_table2(runner, Path(neutral[0]["dir"]), table2_qs, out / "table2")
-            except RunError as e:
-                log.error("Table 2 check FAILED: %s", e)
-        figs = figures.all_figures(results, out / "figures", t2)
-        return {"out": out, "runs": runs, "summary": summ, "fit": fit, "collapse": collapse,
-                "collapse_mid": collapse_mid,
-                "table2": tables.table2_frame(t2) if t2 else None, "figures": figs,
-                "wall_s": time.monotonic() - t0, "complete": len(results) == len(params)}
+        return {"fit": fit, "collapse": collapse, "collapse_mid": collapse_mid}
 
 
 def report(res: dict, study: Reproduction) -> str:

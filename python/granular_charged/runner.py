@@ -11,6 +11,8 @@ is emptied and run again.
 """
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import json
 import logging
 import os
@@ -19,30 +21,31 @@ import shutil
 import subprocess
 import sys
 import time
-from importlib import resources
 from pathlib import Path
 
 from . import packing
+from .deckfile import deck_path, deck_variables
 from .lammps_build import LammpsBuild
-from .params import DepositionParams, coulomb_to_adhesion
+from .params import DepositionParams, ParamError, coulomb_to_adhesion
 
 log = logging.getLogger(__name__)
 
 # 3: charged runs without `inject` now use the plane rain (older results of the same name
 # came from the rain and are run again)
 RESULT_VERSION = 3
-DECKS = ("in.deposition", "in.charged-after-formation")
+# deck variables the runner sets itself (not extra variables of a run)
+RESERVED = {"out": "the run's folder, set by the runner",
+            "tracer": "the runner's tracer argument (--tracer)"}
+# what every reader of result.json uses (tables, figures, the studies, the resumption)
+RESULT_KEYS = ("key", "params", "groups", "phi", "Z", "fZ", "inserted", "natoms", "lost",
+               "flying", "wall_s")
+PARAM_KEYS = ("rp", "U0", "gamma", "q", "N", "seed")
+# the environment variable through which a LAMMPS child learns its parent (child.py watches it)
+PARENT_ENV = "GC_PARENT_PID"
 
 
 class RunError(RuntimeError):
     """A LAMMPS run failed (the message carries the tail of its log)."""
-
-
-def deck_path(name: str):
-    """A deck shipped as package data (a context manager yielding a real file path)."""
-    if name not in DECKS:
-        raise ValueError(f"unknown deck {name!r}; the package has {', '.join(DECKS)}")
-    return resources.as_file(resources.files("granular_charged") / "decks" / name)
 
 
 def write_json(path: Path, data: dict):
@@ -53,15 +56,55 @@ def write_json(path: Path, data: dict):
     os.replace(tmp, path)
 
 
+def result_problem(res) -> str | None:
+    """Why a result.json's content cannot be used (None: it can): not an object, or keys
+    missing that the tables, figures and studies read."""
+    if not isinstance(res, dict):
+        return "not a JSON object"
+    missing = [k for k in RESULT_KEYS if k not in res]
+    if not isinstance(res.get("params"), dict):
+        missing.append("params")
+    else:
+        missing += [f"params.{k}" for k in PARAM_KEYS if k not in res["params"]]
+    if missing:
+        return f"keys missing: {', '.join(dict.fromkeys(missing))}"
+    # written before --var was checked: `--var q 400` ran charged with params.q = 0
+    shadow = sorted(set(res["params"].get("extra") or {}) & set(res["params"]))
+    if shadow:
+        return (f"params.extra sets {', '.join(shadow)} beside params' own value (an older "
+                "version's unchecked --var): its parameters do not describe the run")
+    return None
+
+
 def read_result(path: Path) -> dict | None:
-    """A complete result.json of the current version, else None."""
+    """A complete, usable result.json of the current version, else None."""
     try:
         res = json.loads(Path(path).read_text())
     except (OSError, ValueError):
         return None
-    if res.get("version") == RESULT_VERSION and res.get("complete"):
+    if result_problem(res) is None and res.get("version") == RESULT_VERSION and res.get("complete"):
         return res
     return None
+
+
+@contextlib.contextmanager
+def folder_lock(lockfile: Path, what: str):
+    """Hold an exclusive lock (fcntl.flock) on lockfile while a run uses its folder: two
+    commands writing into one folder at once take turns instead of emptying each other's
+    running folder. Waits (with a log line) while another process holds it; the kernel
+    releases it when the holder exits, however it exits."""
+    lockfile = Path(lockfile)
+    lockfile.parent.mkdir(parents=True, exist_ok=True)
+    with open(lockfile, "a") as fh:
+        try:
+            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            log.info("%s: another process is running it; waiting for it to finish", what)
+            fcntl.flock(fh, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
 
 
 class Runner:
@@ -69,6 +112,8 @@ class Runner:
 
     def __init__(self, build: LammpsBuild, np_ranks: int = 1, timeout: float | None = None,
                  render: bool = True):
+        if not (isinstance(np_ranks, int) and np_ranks >= 1):
+            raise ParamError(f"np_ranks = {np_ranks}: MPI ranks per run must be a whole number >= 1")
         self.build = build
         self.np_ranks = np_ranks
         self.timeout = timeout
@@ -95,7 +140,9 @@ class Runner:
             log.debug("run: %s", " ".join(cmd))
             t0 = time.monotonic()
             ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-            r = subprocess.run(cmd, env=self.build.child_env(), capture_output=True, text=True,
+            env = self.build.child_env()
+            env[PARENT_ENV] = str(os.getpid())    # the child exits when this process dies
+            r = subprocess.run(cmd, env=env, capture_output=True, text=True,
                                timeout=self.timeout)
             wall = time.monotonic() - t0
             ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -118,12 +165,31 @@ class Runner:
     def finished(self, p: DepositionParams, root: Path) -> dict | None:
         return read_result(self.workdir(p, root) / "result.json")
 
+    @staticmethod
+    def check(p: DepositionParams, tracer: int = 0):
+        """ParamError unless p can run: its extra variables are variables of in.deposition that
+        the runner does not set itself, and the tracer is one of its particles."""
+        deck = deck_variables("in.deposition")
+        for k in p.extra:
+            if k in RESERVED:
+                raise ParamError(f"deck variable {k!r}: {RESERVED[k]}")
+            if k not in deck:
+                raise ParamError(f"in.deposition has no variable {k!r}")
+        if not (0 <= tracer <= p.N):
+            raise ParamError(f"tracer = {tracer}: must be a particle id 1..N = {p.N} (0: none)")
+
     def deposition(self, p: DepositionParams, root: Path, force: bool = False,
                    tracer: int = 0) -> dict:
         """Run in.deposition for p in root/<p.key()>, analyse, write result.json, return it.
-        A complete result.json is returned unchanged (with 'skipped': True) unless force."""
+        A complete result.json is returned unchanged (with 'skipped': True) unless force.
+        The run holds root/.<key>.lock meanwhile (see folder_lock)."""
+        self.check(p, tracer)
         wd = self.workdir(p, root)
-        done = None if force else self.finished(p, root)
+        with folder_lock(Path(root) / f".{wd.name}.lock", p.key()):
+            return self._deposition(p, wd, force, tracer)
+
+    def _deposition(self, p: DepositionParams, wd: Path, force: bool, tracer: int) -> dict:
+        done = None if force else read_result(wd / "result.json")
         if done is not None:
             done["skipped"] = True
             done["dir"] = str(wd)
@@ -141,7 +207,12 @@ class Runner:
             variables["tracer"] = str(tracer)
         lmp = self.run_deck("in.deposition", wd, variables, kind="deposition",
                             render=self.render and self.build.can_render)
-        res = self.analyse(wd, p, lmp)
+        try:
+            res = self.analyse(wd, p, lmp)
+        except (OSError, ValueError, KeyError, IndexError, TypeError) as e:
+            # a run LAMMPS finished but whose output cannot be analysed: an error of this run
+            # (no result.json: the folder is run again next time), not a traceback
+            raise RunError(f"{p.key()}: the analysis of {wd} failed: {type(e).__name__}: {e}") from e
         res["tracer"] = tracer
         res["np"] = self.np_ranks
         write_json(wd / "result.json", res)
@@ -156,7 +227,9 @@ class Runner:
         snap = packing.read_dump(Path(workdir) / "final.dump", last_only=True)
         zlo_rp = float(p.extra.get("zlo_rp", 4.0))
         top_rp = float(p.extra.get("top_rp", 6.0))
-        ana = packing.analyse(snap, p.rp, zlo_rp, top_rp)
+        # f(Z) with LAMMPS's bins (compute coord/dist's zmax) when the computes ran
+        zmax = len(lmp["fZ"]) - 1 if lmp.get("fZ") else packing.ZMAX_DEFAULT
+        ana = packing.analyse(snap, p.rp, zlo_rp, top_rp, zmax=zmax)
         py = {k: ana.get(k) for k in ("phi", "Z", "fZ", "n_slab", "zlo", "zhi", "slab_thickness_rp")}
         from_lammps = lmp.get("phi") is not None
         res = {

@@ -19,7 +19,7 @@ from tqdm import tqdm
 from tqdm.contrib.logging import logging_redirect_tqdm
 
 from .params import DepositionParams
-from .runner import RunError, Runner
+from .runner import RunError, Runner, result_problem
 
 log = logging.getLogger(__name__)
 
@@ -35,8 +35,9 @@ PAPER_SETS = tuple(MappingProxyType(s) for s in (
 ))
 
 
-def expand(sets, N, seeds, extra) -> list[DepositionParams]:
-    """Every combination of each set's values and the seeds, as DepositionParams."""
+def expand(sets, N, seeds, extra, fields=None) -> list[DepositionParams]:
+    """Every combination of each set's values and the seeds, as DepositionParams (each run
+    once). ``fields``: other DepositionParams fields for every run (e.g. rho)."""
     def as_list(v):
         return list(v) if isinstance(v, (list, tuple)) else [v]
     out = []
@@ -44,8 +45,9 @@ def expand(sets, N, seeds, extra) -> list[DepositionParams]:
         for rp, U0, gamma, q, seed in itertools.product(
                 as_list(s["rp"]), as_list(s["U0"]), as_list(s["gamma"]), as_list(s["q"]), seeds):
             out.append(DepositionParams(rp=rp, U0=U0, gamma=gamma, q=q, N=N, seed=seed,
-                                        extra=dict(extra)))
-    return out
+                                        extra=dict(extra), **(fields or {})))
+    # a value given twice (--q 0 0, or in two sets) is one run, counted once in the tables
+    return list({p.key(): p for p in out}.values())
 
 
 class Sweep:
@@ -63,6 +65,8 @@ class Sweep:
         """Run every parameter set not finished before; return all results (finished before
         and new) in the order of params, failed runs left out (logged). ``tracer``: particle id
         to follow, or a function of the DepositionParams giving it."""
+        for p in params:          # every run checked before the first starts
+            self.runner.check(p, tracer(p) if callable(tracer) else tracer)
         self.out.mkdir(parents=True, exist_ok=True)
         results: dict[int, dict] = {}
         todo = []
@@ -150,22 +154,21 @@ def fmt(v, spec: str) -> str:
 
 
 def load_results(out: Path) -> list[dict]:
-    """Every complete result.json under out/*/ (with 'dir', its folder)."""
+    """Every complete, usable result.json under out/*/ (with 'dir', its folder); the others are
+    named in a warning and left out."""
     res = []
     for f in sorted(Path(out).glob("*/result.json")):
         try:
             r = json.loads(f.read_text())
-        except ValueError:
-            log.warning("%s: not valid JSON, ignored", f)
+        except (OSError, ValueError) as e:
+            log.warning("%s: not valid JSON (%s), ignored", f, e)
+            continue
+        problem = result_problem(r)
+        if problem:
+            log.warning("%s: %s, ignored", f, problem)
             continue
         if r.get("complete"):
             r["dir"] = str(f.parent)
             res.append(r)
     return res
 
-
-if __name__ == "__main__":      # the older spelling, python3 -m granular_charged.sweep ...
-    import sys
-
-    from .cli import main
-    sys.exit(main(["sweep", *sys.argv[1:]]))

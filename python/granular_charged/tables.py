@@ -25,15 +25,21 @@ def runs_frame(results: list[dict]) -> pd.DataFrame:
         })
     cols = list(CASE) + ["seed", "N", "Ad", "Estar", "Adstar", "phi", "Z", "phi_python", "Z_python",
                    "natoms", "lost", "flying", "wall_s", "key", "dir"]
-    return pd.DataFrame(rows, columns=cols)
+    df = pd.DataFrame(rows, columns=cols)
+    # a run without an analysis slab has phi = <Z> = None: NaN, whatever the other runs have
+    for c in ("phi", "Z", "phi_python", "Z_python"):
+        df[c] = pd.to_numeric(df[c], errors="coerce")
+    return df
 
 
 def summary(runs: pd.DataFrame) -> pd.DataFrame:
-    """Per case (r_p, U_0, gamma, q): runs, mean and standard deviation of phi and <Z> over the
-    seeds, the groups, atoms, particles lost, mean wall time; and phi_0/phi - 1 against the
-    neutral case of the same (r_p, U_0, gamma) (NaN without one)."""
+    """Per case (r_p, U_0, gamma, q): runs (those with an analysis slab, which the means and
+    standard deviations of phi and <Z> over the seeds are made of), no_slab (the runs whose bed
+    was too thin for one), the groups, atoms, particles lost, mean wall time; and phi_0/phi - 1
+    against the neutral case of the same (r_p, U_0, gamma) (NaN without one)."""
     s = (runs.groupby(list(CASE), as_index=False)
-         .agg(runs=("phi", "size"), phi=("phi", "mean"), phi_sd=("phi", "std"),
+         .agg(runs=("phi", "count"), no_slab=("phi", lambda v: int(v.isna().sum())),
+              phi=("phi", "mean"), phi_sd=("phi", "std"),
               Z=("Z", "mean"), Z_sd=("Z", "std"), Ad=("Ad", "first"), Estar=("Estar", "first"),
               Adstar=("Adstar", "first"), N=("natoms", "mean"), lost=("lost", "sum"),
               wall_s=("wall_s", "mean")))
@@ -111,7 +117,7 @@ def adstar_collapse(runs: pd.DataFrame, barrier_fraction: float = 1.0) -> pd.Dat
     collapse" and "One particle at a time")."""
     r = runs.assign(Adstar=adstar(runs, barrier_fraction))
     s = (r.groupby(list(CASE), as_index=False)
-         .agg(runs=("phi", "size"), Adstar=("Adstar", "first"), phi=("phi", "mean"),
+         .agg(runs=("phi", "count"), Adstar=("Adstar", "first"), phi=("phi", "mean"),
               phi_sd=("phi", "std"), Z=("Z", "mean"), Z_sd=("Z", "std")))
     s = s[np.isfinite(s["Adstar"]) & (s["Adstar"] > 0)].copy()
     neutral = s[s["q"] == 0]

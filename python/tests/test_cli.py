@@ -11,10 +11,10 @@ import pytest
 
 from conftest import SRC
 
-SUBCOMMANDS = ("run", "sweep", "figures", "demo", "reproduce")
+SUBCOMMANDS = ("run", "sweep", "figures", "table2", "demo", "reproduce")
 
 
-def test_help_lists_the_five_subcommands(cli, tmp_path):
+def test_help_lists_the_subcommands(cli, tmp_path):
     out = cli(["--help"], cwd=tmp_path).stdout
     for c in SUBCOMMANDS:
         assert f"\n    {c} " in out, c
@@ -23,7 +23,8 @@ def test_help_lists_the_five_subcommands(cli, tmp_path):
 
 
 @pytest.mark.parametrize("cmd,opt", [("run", "--seed"), ("sweep", "--seeds"), ("figures", "--table2"),
-                                     ("demo", "--table2-q"), ("reproduce", "--quick")])
+                                     ("table2", "--q"), ("demo", "--table2-q"),
+                                     ("reproduce", "--quick")])
 def test_each_subcommand_has_help(cli, tmp_path, cmd, opt):
     r = cli([cmd, "--help"], cwd=tmp_path)
     assert f"usage: granular-charged {cmd}" in r.stdout and opt in r.stdout

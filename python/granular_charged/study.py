@@ -1,0 +1,90 @@
+"""One runner for the studies of the command line (``demo`` and ``reproduce``): the depositions
+of a list of cases and seeds (a resumable sweep), runs.csv and summary.csv, the Table 2 check on
+the first neutral packing of the Fig. 2 case, and the figures, all in one folder.
+
+A study says which runs it wants (:meth:`Study.params`), which particle to follow
+(:meth:`Study.tracer`), the charges of its Table 2 check (:meth:`Study.table2_charges`) and what
+it computes from the runs besides the summary (:meth:`Study.analyse`); :meth:`Study.run` is the
+rest, the same for every study.
+"""
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from . import figures, tables
+from .after_formation import run_table2
+from .params import DepositionParams
+from .runner import RunError, Runner
+from .sweep import Sweep
+
+log = logging.getLogger(__name__)
+
+# the paper's Fig. 2 case, whose first neutral packing the Table 2 check charges
+FIG2_CASE = {"rp": DepositionParams.rp, "U0": DepositionParams.U0,
+             "gamma": DepositionParams.gamma, "q": 0.0}
+
+
+@dataclass
+class Study:
+    """Depositions for cases and seeds, then tables, the Table 2 check and the figures."""
+    out: Path
+    seeds: tuple = (1, 2, 3)
+    table2_qs: tuple = (0.0, 260.0, 400.0)
+    extra: dict = field(default_factory=dict)    # deck variables for every run
+    fields: dict = field(default_factory=dict)   # DepositionParams fields for every run (rho, ...)
+    jobs: int = 1
+    progress: bool = True
+
+    # ---- what a study chooses ----------------------------------------------------------------
+    def params(self, have_fmm: bool) -> list[DepositionParams]:
+        """The depositions (charged ones only when the build has fix coul/fmm)."""
+        raise NotImplementedError
+
+    def tracer(self, p: DepositionParams) -> int:
+        """Particle id to follow in run p (0: none)."""
+        return 0
+
+    def table2_charges(self) -> tuple:
+        return tuple(self.table2_qs)
+
+    def analyse(self, runs, summary, out: Path) -> dict:
+        """The study's own analyses of the runs (written under out); entries of run()'s result."""
+        return {}
+
+    # ---- the same for every study -----------------------------------------------------------
+    def run(self, runner: Runner) -> dict:
+        t0 = time.monotonic()
+        out = Path(self.out).resolve()
+        have_fmm = runner.build.capabilities["coul/fmm"]
+        if not have_fmm:
+            log.warning("fix coul/fmm is NOT in this build: only the neutral cases run; the "
+                        "charged cases need fix coul/fmm (they are not faked)")
+        params = self.params(have_fmm)
+        results = Sweep(runner, out / "runs", jobs=self.jobs, progress=self.progress).run(
+            params, tracer=self.tracer)
+        runs = tables.runs_frame(results)
+        summ = tables.summary(runs)
+        runs.drop(columns=["dir"]).to_csv(out / "runs.csv", index=False)
+        summ.to_csv(out / "summary.csv", index=False)
+        res = {"out": out, "results": results, "runs": runs, "summary": summ,
+               "have_fmm": have_fmm, **self.analyse(runs, summ, out)}
+        t2 = []
+        formed = sorted((r for r in results
+                         if all(r["params"][k] == v for k, v in FIG2_CASE.items())),
+                        key=lambda r: r["params"]["seed"])
+        qs = self.table2_charges()
+        if formed and have_fmm and qs:
+            # the Table 2 runs take the formed run's settings (run_table2)
+            try:
+                t2 = run_table2(runner, Path(formed[0]["dir"]), qs, out / "table2",
+                                jobs=self.jobs)
+            except RunError as e:
+                log.error("Table 2 check FAILED: %s", e)
+        res["table2"] = tables.table2_frame(t2) if t2 else None
+        res["figures"] = figures.all_figures(results, out / "figures", t2)
+        res["wall_s"] = time.monotonic() - t0
+        res["complete"] = len(results) == len(params)
+        return res
