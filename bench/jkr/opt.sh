@@ -5,7 +5,9 @@
 #       each, newton off), from LAMMPS's timing breakdown;
 #   (b) a demo-size neutral deposition (N = 500, L = 14 r_p, the default deck; or DEPO_VARS),
 #       both styles started together (one per core): user CPU, steps, pair time per step, phi.
-# LMP=<build>/lmp selects the build. SKIP_DEPOSITION=1 runs (a) only.
+# LMP=<build>/lmp selects the build; LMP_BEFORE=<another build>/lmp adds that build's
+# pair_style granular to each round of (a) and (b) (e.g. the build before a change).
+# SKIP_DEPOSITION=1 runs (a) only.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 lmp=${LMP:-$here/../../build/lmp}
@@ -17,17 +19,25 @@ read -r -a depo_vars <<< "${DEPO_VARS:--var N 500 -var L_rp 14 -var seed 1}"
 model="jkr/marshall 2e8 0.7 0.33 0.01 damping marshall tangential marshall 0.3 rolling marshall 0.01 twisting marshall/jkr"
 export LD_LIBRARY_PATH="$build${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 best() { sort -g | head -n 1; }
-pair_time() {    # <style>: pair seconds of the timed run of in.packing
-  "$lmp" -log none -echo none -in "$here/in.packing" -var model "$model" -var steps "$steps" \
+before=${LMP_BEFORE:-}
+pair_time() {    # <style> [<lmp>]: pair seconds of the timed run of in.packing
+  LD_LIBRARY_PATH="$(dirname "${2:-$lmp}")${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}" "${2:-$lmp}" -log none -echo none -in "$here/in.packing" -var model "$model" -var steps "$steps" \
     -var pair "$1" | awk '/^Pair/ {t=$3} END {print t}'
 }
-t_ref=(); t_opt=()
+t_ref=(); t_opt=(); t_before=()
 for rep in $(seq "$reps"); do
   t=$(pair_time granular); t_ref+=("$t"); echo "packing rep $rep granular: pair $t s / $steps steps"
   t=$(pair_time granular/opt); t_opt+=("$t"); echo "packing rep $rep granular/opt: pair $t s"
+  if [[ -n $before ]]; then
+    t=$(pair_time granular "$before"); t_before+=("$t"); echo "packing rep $rep granular of $before: pair $t s"
+  fi
 done
 a=$(printf '%s\n' "${t_opt[@]}" | best); b=$(printf '%s\n' "${t_ref[@]}" | best)
 awk -v a="$a" -v b="$b" -v s="$steps" 'BEGIN {printf "(a) settled packing: pair %.3f ms/step granular, %.3f granular/opt, opt / granular %.3f\n", 1e3*b/s, 1e3*a/s, a/b}'
+if [[ -n $before ]]; then
+  o=$(printf '%s\n' "${t_before[@]}" | best)
+  awk -v a="$a" -v b="$b" -v o="$o" -v s="$steps" 'BEGIN {printf "(a) before: pair %.3f ms/step granular; granular / before %.3f, opt / before %.3f\n", 1e3*o/s, b/o, a/o}'
+fi
 [[ -n ${SKIP_DEPOSITION:-} ]] && exit 0
 
 out=$(mktemp -d)

@@ -59,7 +59,7 @@ void GranSubModDampingMarshall::init()
 
 double GranSubModDampingMarshall::calculate_forces()
 {
-  damp_prefactor = MarshallKernels::damping_prefactor(alpha, mass_factor, gm->meff,
-                                                      jkr->get_emix(), gm->contact_radius);
+  damp_prefactor = MarshallKernels::damping_prefactor(
+      alpha, MarshallKernels::damping_sqrt_mass(mass_factor, gm->meff), jkr->get_contact());
   return -damp_prefactor * gm->vnnr;
 }

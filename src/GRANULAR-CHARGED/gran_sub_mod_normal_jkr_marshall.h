@@ -43,6 +43,7 @@ namespace Granular_NS {
     double get_surface_energy() const { return cohesion; }      //!< gamma
     double get_restitution() const { return restitution; }      //!< e, for damping marshall
     double get_adhesive_force() const { return contact.adhesive; }    //!< 4 F_C (a/a_0)^(3/2)
+    const MarshallKernels::NormalForce &get_contact() const { return contact; }    //!< current contact
 
    protected:
     double restitution;    // e, coefficient of restitution

@@ -51,6 +51,7 @@ namespace MarshallKernels {
     double inv_deltac = 0.0;     // 1 / delta_C (0 without adhesion)
     double asep = 0.0;           // contact radius at separation, a_0 / 6^(2/3)
     double fc = 0.0;             // F_C = 3 pi gamma R
+    double sqrt_kn_sep = 0.0;    // sqrt(4/3 E* a_sep): sqrt(k_N) = s sqrt_kn_sep, as a = a_sep s^2
   };
 
   // delta_C, a_sep = (pi gamma R^2 / (4 E*))^(1/3) and F_C for radius R, recomputed only when R
@@ -63,6 +64,7 @@ namespace MarshallKernels {
     sc.inv_deltac = (sc.deltac > 0.0) ? 1.0 / sc.deltac : 0.0;
     sc.asep = cbrt(PI * gamma * reff * reff / (4.0 * emix));
     sc.fc = 3.0 * PI * gamma * reff;
+    sc.sqrt_kn_sep = sqrt(4.0 / 3.0 * emix * sc.asep);
   }
 
   // contact life (Marshall 2009): forms at delta >= 0, persists in tension to delta = -delta_C
@@ -81,6 +83,7 @@ namespace MarshallKernels {
     double fne;         // elastic-adhesive normal force F_ne (positive: repulsive)
     double adhesive;    // adhesive part 4 F_C (a/a_0)^(3/2), for rolling marshall
     double pulloff;     // F_C (0 without adhesion)
+    double sqrt_kn;     // sqrt(k_N), k_N = 4/3 E* a: the normal stiffness the damping scales with
   };
 
   // JKR contact radius on the stable branch, a = a_sep s^2 with s^4 - 4 s = 3 delta / delta_C
@@ -97,6 +100,7 @@ namespace MarshallKernels {
       n.fne = 4.0 / 3.0 * emix * n.a * n.a * n.a / reff;
       n.adhesive = 0.0;
       n.pulloff = 0.0;
+      n.sqrt_kn = sqrt(4.0 / 3.0 * emix * n.a);
       return n;
     }
     const double s = JKRScaled::root(delta * sc.inv_deltac);
@@ -104,6 +108,7 @@ namespace MarshallKernels {
     n.adhesive = JKRScaled::adhesive_over_fc(s) * sc.fc;
     n.fne = JKRScaled::force_over_fc(s) * sc.fc;
     n.pulloff = sc.fc;
+    n.sqrt_kn = s * sc.sqrt_kn_sep;
     return n;
   }
 
@@ -129,12 +134,17 @@ namespace MarshallKernels {
     return (e == 1.0 || alpha < 0.0) ? 0.0 : alpha;
   }
 
-  // eta_N; a >= 0.30285 a_0 > 0 for every live JKR contact, so k_N > 0 also in tension
-  inline double damping_prefactor(double alpha, double mass_factor, double meff, double emix,
-                                  double a)
+  // sqrt(mass_factor m*): the mass part of eta_N, a constant of a pair of particles
+  inline double damping_sqrt_mass(double mass_factor, double meff)
   {
-    const double kn = 4.0 / 3.0 * emix * a;
-    return alpha * sqrt(mass_factor * meff * (kn > 0.0 ? kn : 0.0));
+    return sqrt(mass_factor * meff);
+  }
+
+  // eta_N = alpha sqrt(mass_factor m*) sqrt(k_N); a >= 0.30285 a_0 > 0 for every live JKR
+  // contact, so k_N > 0 also in tension
+  inline double damping_prefactor(double alpha, double sqrt_mass, const NormalForce &n)
+  {
+    return alpha * sqrt_mass * n.sqrt_kn;
   }
 
   /* ---------------------------------------------------------------------
@@ -142,20 +152,21 @@ namespace MarshallKernels {
      F_t = -k_T h - eta_T v_t, k_T = 8 G* a, |F_t| <= mu F_crit  (Marshall 2009, eq. 24).
      h is first rotated into the current tangent plane keeping its length (Luding, Gran.
      Matter 10, 235 (2008), eq. 17), then advanced by v_t dt; on slip F_t is scaled to the limit
-     and h reset to the spring length that gives its elastic part. Same operations as LAMMPS
-     4Jul2026's mindlin (history of the displacement, no unloading rescale).
+     and h reset to the spring length that gives its elastic part. LAMMPS 4Jul2026's mindlin
+     with the history of the displacement and no unloading rescale, up to rounding (squares
+     compared instead of lengths, one square root in the rotation).
   --------------------------------------------------------------------- */
 
-  // v -= (v . n) n, then restore |v| (LAMMPS's GranSubMod::rotate_rescale_vec)
-  inline void rotate_into_plane(double *v, const double *n)
+  // v -= (v . n) n, then restore |v| (as LAMMPS's GranSubMod::rotate_rescale_vec, with one
+  // square root): the history of a contact follows the rotation of its tangent plane
+  inline void rotate_into_plane(double *v, const double *n, double vn)
   {
-    const double rsht = MathExtra::dot3(v, n);
-    const double shrmag = MathExtra::len3(v);
+    const double lensq = MathExtra::lensq3(v);
     double along[3];
-    MathExtra::scale3(rsht, n, along);
+    MathExtra::scale3(vn, n, along);
     MathExtra::sub3(v, along, v);
-    const double prjmag = MathExtra::len3(v);
-    MathExtra::scale3(prjmag > 0 ? shrmag / prjmag : 0, v);
+    const double plensq = MathExtra::lensq3(v);
+    MathExtra::scale3(plensq > 0.0 ? sqrt(lensq / plensq) : 0.0, v);
   }
 
   inline void tangential_force(double *history, const double *nx, const double *vtr, double dt,
@@ -164,7 +175,7 @@ namespace MarshallKernels {
   {
     if (history_update) {
       const double rsht = MathExtra::dot3(history, nx);
-      if ((fabs(rsht) * k_scaled) > (FRAME_EPSILON * fscrit)) rotate_into_plane(history, nx);
+      if ((fabs(rsht) * k_scaled) > (FRAME_EPSILON * fscrit)) rotate_into_plane(history, nx, rsht);
       double increment[3];
       MathExtra::scale3(dt, vtr, increment);
       MathExtra::add3(history, increment, history);
@@ -174,10 +185,10 @@ namespace MarshallKernels {
     MathExtra::scale3(-damp, vtr, fdamp);
     MathExtra::add3(fs, fdamp, fs);
 
-    const double magfs = MathExtra::len3(fs);
-    if (magfs > fscrit) {
-      if (MathExtra::len3(history) != 0.0) {
-        MathExtra::scale3(fscrit / magfs, fs);
+    const double magfs_sq = MathExtra::lensq3(fs);
+    if (magfs_sq > fscrit * fscrit) {
+      if (MathExtra::lensq3(history) != 0.0) {
+        MathExtra::scale3(fscrit / sqrt(magfs_sq), fs);
         MathExtra::sub3(fs, fdamp, history);
         MathExtra::scale3(-1.0 / k_scaled, history);
       } else {
@@ -201,14 +212,7 @@ namespace MarshallKernels {
     MathExtra::copy3(history, xi);
     if (history_update) {
       const double xin = MathExtra::dot3(xi, nx);
-      if (xin != 0.0) {
-        // drop the normal part and restore the length
-        const double lensq = MathExtra::lensq3(xi);
-        MathExtra::scale3(xin, nx, tmp);
-        MathExtra::sub3(xi, tmp, xi);
-        const double plensq = MathExtra::lensq3(xi);
-        MathExtra::scale3(plensq > 0.0 ? sqrt(lensq / plensq) : 0.0, xi);
-      }
+      if (xin != 0.0) rotate_into_plane(xi, nx, xin);
       MathExtra::scale3(dt, vrl, tmp);
       MathExtra::add3(xi, tmp, xi);
     }

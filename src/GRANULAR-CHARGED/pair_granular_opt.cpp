@@ -190,7 +190,12 @@ void PairGranularOpt::compute(int eflag, int vflag)
         // most neighbors of a deposition do not touch: reject those before R_eff and the scales
         // (their history is zero already: zeroed when the contact ended, or new from the list)
         if (!touch[jj] && rsq >= radsum * radsum) continue;
-        const double reff = radi * radj / radsum;
+        if (radi != fm.radi || radj != fm.radj) {
+          fm.radi = radi;
+          fm.radj = radj;
+          fm.reff = radi * radj / radsum;
+        }
+        const double reff = fm.reff;
         MK::use_jkr_scales(fm.scales, reff, fm.gamma, fm.emix);
         if (!MK::jkr_touch(touch[jj] != 0, rsq, radsum, fm.scales.deltac)) {
           touch[jj] = 0;
@@ -199,11 +204,20 @@ void PairGranularOpt::compute(int eflag, int vflag)
         }
         touch[jj] = 1;
 
-        double mi = rmass[i];
-        double mj = rmass[j];
-        double meff = mi * mj / (mi + mj);
+        const double mi = rmass[i];
+        const double mj = rmass[j];
+        if (mi != fm.mi || mj != fm.mj) {
+          fm.mi = mi;
+          fm.mj = mj;
+          fm.meff = mi * mj / (mi + mj);
+        }
+        double meff = fm.meff;
         if (mask[i] & freeze_group_bit) meff = mj;
         if (mask[j] & freeze_group_bit) meff = mi;
+        if (meff != fm.sqrt_mass_of) {
+          fm.sqrt_mass_of = meff;
+          fm.sqrt_mass = MK::damping_sqrt_mass(fm.mass_factor, meff);
+        }
         const double dt = model->dt;
 
         // kinematics (GranularModel::calculate_forces)
@@ -222,8 +236,7 @@ void PairGranularOpt::compute(int eflag, int vflag)
 
         // normal: JKR with Marshall damping
         const MK::NormalForce nf = MK::jkr_normal_force(fm.scales, fm.gamma, fm.emix, delta, reff);
-        const double damp_prefactor =
-            MK::damping_prefactor(fm.alpha, fm.mass_factor, meff, fm.emix, nf.a);
+        const double damp_prefactor = MK::damping_prefactor(fm.alpha, fm.sqrt_mass, nf);
         const double fntot = nf.fne + (-damp_prefactor * vnnr);
         const double fncrit = MK::critical_force(nf);
 
