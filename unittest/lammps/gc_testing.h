@@ -9,6 +9,8 @@
 #include "variable.h"
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
@@ -47,6 +49,39 @@ class Lmp {
   double torque(int id, int d) { return lmp->atom->torque[lmp->atom->map(id)][d]; }
   LAMMPS_NS::LAMMPS *lmp;
 };
+
+// Run `lines` in a separate lmp process (the executable `lmp`), as a user's run is, then return
+// x y z vx omegax of every atom sorted by ID (empty, with a test failure, if the run failed).
+// Separate processes matter for restarts: LAMMPS 4Jul2026 names pair granular's history fix
+// after a per-process instance counter, and read_restart restores the history only into a fix
+// of the same name.
+inline std::vector<double> lmp_process(const std::string &lmp, const std::vector<std::string> &lines,
+                                       const std::string &tag, bool *ok)
+{
+  const std::string input = "in.gctest_" + tag, dump = "gctest_" + tag + ".state";
+  {
+    FILE *fp = fopen(input.c_str(), "w");
+    for (const auto &l : lines) fprintf(fp, "%s\n", l.c_str());
+    fprintf(fp, "write_dump all custom %s id x y z vx omegax modify sort id format float %%.17g\n",
+            dump.c_str());
+    fclose(fp);
+  }
+  const std::string cmd = lmp + " -in " + input + " -log none -screen none";
+  std::vector<double> s;
+  *ok = std::system(cmd.c_str()) == 0;
+  FILE *fp = *ok ? fopen(dump.c_str(), "r") : nullptr;
+  char line[512];
+  while (fp && fgets(line, sizeof line, fp)) {
+    int id;
+    double v[5];
+    if (sscanf(line, "%d %lg %lg %lg %lg %lg", &id, v, v + 1, v + 2, v + 3, v + 4) == 6)
+      s.insert(s.end(), v, v + 5);
+  }
+  if (fp) fclose(fp);
+  std::remove(input.c_str());
+  std::remove(dump.c_str());
+  return s;
+}
 
 // ---- JKR closed forms (doc/theory.md, eqs. (1.2)-(1.4)), independent of LAMMPS's implementation ----------
 struct JKR {

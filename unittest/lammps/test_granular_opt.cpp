@@ -193,6 +193,26 @@ TEST(PairGranularOpt, TypePairOutsideTheFusedSet)
   expect_same_state(ref.after, opt.after);
 }
 
+// compute pair/local asks the pair style's single(): the same contacts and forces
+TEST(PairGranularOpt, PairLocalAsGranular)
+{
+  std::vector<double> sums[2];
+  int k = 0;
+  for (const std::string style : {"granular", "granular/opt"}) {
+    Lmp l;
+    l.cmds(cluster(style, "on"));
+    l.cmds({"run 200", "compute pl all pair/local dist force p1 p2 p3 p4",
+            "compute plsum all reduce sum c_pl[1] c_pl[2] c_pl[3] c_pl[4] c_pl[5] c_pl[6]",
+            "run 0 post no"});
+    for (int c = 1; c <= 6; ++c) sums[k].push_back(l.var(fmt::format("c_plsum[{}]", c)));
+    ++k;
+  }
+  for (int c = 0; c < 6; ++c) {
+    EXPECT_NE(sums[0][c], 0.0) << "column " << c;
+    EXPECT_NEAR(sums[1][c], sums[0][c], TOL * std::fabs(sums[0][c])) << "column " << c;
+  }
+}
+
 TEST(PairGranularOpt, SuffixSelectsIt)
 {
   Lmp l;
@@ -207,32 +227,9 @@ TEST(PairGranularOpt, SuffixSelectsIt)
 namespace {
 std::vector<double> lmp_process(const std::vector<std::string> &lines, const std::string &tag)
 {
-  const std::string input = "in.granular_opt_" + tag, dump = "granular_opt_" + tag + ".state";
-  {
-    FILE *fp = fopen(input.c_str(), "w");
-    for (const auto &l : lines) fprintf(fp, "%s\n", l.c_str());
-    fprintf(fp, "write_dump all custom %s id x y z vx omegax modify sort id format float %%.17g\n",
-            dump.c_str());
-    fclose(fp);
-  }
-  const std::string cmd =
-      std::string(GC_LMP_EXECUTABLE) + " -in " + input + " -log none -screen none";
-  std::vector<double> s;
-  if (std::system(cmd.c_str()) != 0) {
-    ADD_FAILURE() << "failed: " << cmd;
-    return s;
-  }
-  FILE *fp = fopen(dump.c_str(), "r");
-  char line[512];
-  while (fp && fgets(line, sizeof line, fp)) {
-    int id;
-    double v[5];
-    if (sscanf(line, "%d %lg %lg %lg %lg %lg", &id, v, v + 1, v + 2, v + 3, v + 4) == 6)
-      s.insert(s.end(), v, v + 5);
-  }
-  if (fp) fclose(fp);
-  std::remove(input.c_str());
-  std::remove(dump.c_str());
+  bool ok;
+  auto s = gctest::lmp_process(GC_LMP_EXECUTABLE, lines, "granular_opt_" + tag, &ok);
+  if (!ok) ADD_FAILURE() << "lmp run " << tag << " failed";
   return s;
 }
 }    // namespace

@@ -98,32 +98,9 @@ TEST(JKRMarshallReproducible, NewtonOnOff)
 namespace {
 std::vector<double> lmp_process(const std::vector<std::string> &lines, const std::string &tag)
 {
-  const std::string input = "in.jkr_marshall_" + tag, dump = "jkr_marshall_" + tag + ".dump";
-  {
-    FILE *fp = fopen(input.c_str(), "w");
-    for (const auto &l : lines) fprintf(fp, "%s\n", l.c_str());
-    fprintf(fp, "write_dump all custom %s id x y z vx omegax modify sort id format float %%.17g\n",
-            dump.c_str());
-    fclose(fp);
-  }
-  const std::string cmd = std::string(GC_LMP_EXECUTABLE) + " -in " + input + " -log none -screen none";
-  std::vector<double> s;
-  if (std::system(cmd.c_str()) != 0) {
-    ADD_FAILURE() << "failed: " << cmd;
-    return s;
-  }
-  FILE *fp = fopen(dump.c_str(), "r");
-  if (!fp) return s;
-  char line[512];
-  for (int k = 0; k < 9; ++k)    // dump header
-    if (!fgets(line, sizeof line, fp)) break;
-  int id;
-  double v[5];
-  while (fscanf(fp, "%d %lg %lg %lg %lg %lg", &id, v, v + 1, v + 2, v + 3, v + 4) == 6)
-    s.insert(s.end(), v, v + 5);
-  fclose(fp);
-  std::remove(input.c_str());
-  std::remove(dump.c_str());
+  bool ok;
+  auto s = gctest::lmp_process(GC_LMP_EXECUTABLE, lines, "jkr_marshall_" + tag, &ok);
+  if (!ok) ADD_FAILURE() << "lmp run " << tag << " failed";
   return s;
 }
 }    // namespace
