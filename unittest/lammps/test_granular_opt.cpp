@@ -202,7 +202,7 @@ TEST(PairGranularOpt, PairLocalAsGranular)
     Lmp l;
     l.cmds(cluster(style, "on"));
     l.cmds({"run 200", "compute pl all pair/local dist force p1 p2 p3 p4",
-            "compute plsum all reduce sum c_pl[1] c_pl[2] c_pl[3] c_pl[4] c_pl[5] c_pl[6]",
+            "compute plsum all reduce sum c_pl[1] c_pl[2] c_pl[3] c_pl[4] c_pl[5] c_pl[6] inputs local",
             "run 0 post no"});
     for (int c = 1; c <= 6; ++c) sums[k].push_back(l.var(fmt::format("c_plsum[{}]", c)));
     ++k;
