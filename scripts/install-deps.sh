@@ -4,7 +4,7 @@
 set -euo pipefail
 packages=(build-essential cmake ninja-build ccache git xz-utils ca-certificates
           libopenmpi-dev openmpi-bin libfftw3-dev libeigen3-dev voro++-dev libpng-dev
-          libgtest-dev libgmock-dev libbenchmark-dev
+          libgtest-dev libgmock-dev libbenchmark-dev libyaml-dev
           python3 python3-numpy python3-scipy python3-matplotlib python3-pytest
           python3-pandas python3-tqdm python3-venv python3-pip python3-setuptools)
 missing=()
