@@ -14,8 +14,8 @@
    with cap(R, d) = pi (R - d)^2 (2 R + d) / 3 the part of the ball beyond a
    plane at signed distance d from its centre (0 for d >= R, the whole ball
    for d <= -R). With z periodic, every image z + n Lz is included: a slab thicker than Lz
-   holds k = floor((zhi - zlo) / Lz) whole periods (every sphere k times, whole) plus a
-   remainder slab thinner than Lz, so the cost per atom stays O(1) for any slab.
+   holds k whole periods (every sphere k times, whole) plus a remainder slab thinner than Lz
+   between the bounds wrapped into the box, so the cost per atom stays O(1) for any slab.
 ------------------------------------------------------------------------- */
 
 #include "compute_packing_slab.h"
@@ -95,15 +95,31 @@ void ComputePackingSlab::tally()
 
   const int zper = domain->zperiodic;
   const double lz = domain->zprd;
-  double periods = 0.0, rlo = lo, rhi = hi;
+  double whole = 0.0, rlo = lo, rhi = hi;    // whole: share of the slab in whole periods
   if (zper && hi > lo) {
-    periods = floor((hi - lo) / lz);
-    rlo = domain->boxlo[2] + fmod(lo - domain->boxlo[2], lz);
-    if (rlo < domain->boxlo[2]) rlo += lz;
-    rhi = rlo + MAX(0.0, (hi - lo) - periods * lz);
+    if (!std::isfinite(hi - lo))
+      error->all(FLERR, Error::NOLASTLINE, "Compute packing/slab {}: slab {} .. {} is not finite",
+                 id, lo, hi);
+    // each bound wrapped into the box on its own (fmod is exact): the remainder slab is then
+    // shorter than Lz however far outside the box the bounds lie, so the images below are a
+    // few per atom (a remainder taken as (hi - lo) - periods Lz carries the round-off of
+    // hi - lo, which for bounds far outside the box is many periods); a slab of whole periods
+    // (the box itself, or [zlo - k Lz, zhi + m Lz]) has no remainder and gives phi of the box
+    const auto wrap = [&](double z) {
+      double w = domain->boxlo[2] + fmod(z - domain->boxlo[2], lz);
+      if (w < domain->boxlo[2]) w += lz;
+      return w < domain->boxhi[2] ? w : domain->boxlo[2];
+    };
+    rlo = wrap(lo);
+    double rest = wrap(hi) - rlo;
+    if (rest < 0.0) rest += lz;
+    // k Lz / (hi - lo), not k itself: k overflows for bounds like +-1e300 in a thin box
+    whole = MAX(0.0, 1.0 - rest / (hi - lo));
+    rhi = rlo + rest;
   }
 
-  double loc[2] = {0.0, 0.0}, all[2];
+  // [0] sphere volume in the remainder slab, [1] spheres in the slab, [2] whole sphere volumes
+  double loc[3] = {0.0, 0.0, 0.0}, all[3];
   if (hi > lo) {
     for (int i = 0; i < nlocal; i++) {
       if (!(mask[i] & groupbit)) continue;
@@ -115,22 +131,24 @@ void ComputePackingSlab::tally()
         nlo = floor((rlo - r - x[i][2]) / lz);
         nhi = ceil((rhi + r - x[i][2]) / lz);
       }
-      double v = periods * full;
+      double v = 0.0;
       for (double n = nlo; n <= nhi; n += 1.0) {
         const double z = x[i][2] + n * lz;
         if (z + r <= rlo || z - r >= rhi) continue;
         v += MAX(0.0, full - sphere_cap_volume(r, z - rlo) - sphere_cap_volume(r, rhi - z));
       }
-      if (v > 0.0) {
-        loc[0] += v;
-        loc[1] += 1.0;
-      }
+      loc[0] += v;
+      loc[2] += full;
+      if (v > 0.0 || whole > 0.0) loc[1] += 1.0;
     }
   }
-  MPI_Allreduce(loc, all, 2, MPI_DOUBLE, MPI_SUM, world);
+  MPI_Allreduce(loc, all, 3, MPI_DOUBLE, MPI_SUM, world);
 
-  const double vslab = (hi > lo) ? domain->xprd * domain->yprd * (hi - lo) : 0.0;
-  result[0] = (vslab > 0.0) ? all[0] / vslab : 0.0;
+  // phi = (k sum V + V_rest) / (A (hi - lo)) = whole sum V / (A Lz) + V_rest / (A (hi - lo))
+  const double area = domain->xprd * domain->yprd;
+  const double vslab = (hi > lo) ? area * (hi - lo) : 0.0;
+  result[0] = (vslab > 0.0) ? all[0] / vslab + (whole > 0.0 ? whole * all[2] / (area * lz) : 0.0)
+                            : 0.0;
   result[1] = all[1];
   result[2] = vslab;
 }

@@ -20,6 +20,7 @@
 #include "neigh_list.h"
 #include "neigh_request.h"
 #include "neighbor.h"
+#include "pair.h"
 #include "respa.h"
 #include "update.h"
 
@@ -53,12 +54,36 @@ enum : int {
   EVAL_COLS = 22
 };
 
+// restart format: the global list starts with this marker (older files start with the step of
+// the last evaluation, >= -1, and hold no charge checksum: they are evaluated afresh)
+static constexpr double RESTART_FORMAT_CHECKSUM = -2.0;
+enum : int { RESTART_GLOBAL_SIZE = 15 };
+
+// hash of one charged atom (ID, charge bits) for the checksum of the charges: summed modulo
+// 2^64 over the atoms, so the sum does not depend on their order or on the ranks holding them
+// (splitmix64 finaliser: a changed charge or ID changes the sum except with odds ~2^-64)
+static uint64_t mix64(uint64_t z)
+{
+  z += 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+static uint64_t charge_hash(tagint tag, double q)
+{
+  uint64_t bits;
+  memcpy(&bits, &q, sizeof(bits));
+  return mix64((uint64_t) tag ^ mix64(bits));
+}
+
 /* ---------------------------------------------------------------------- */
 
 FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), opts(new gcfmm::Options), solver_boundary(-1), every(1), tolerance(0.0),
     stride(1), mts_estimate(-1.0), nevaluations(0), extrapolate(true), near_cutoff(0.0), last_computed(-1),
-    natoms_computed(-1), box_computed{0.0, 0.0, 0.0, 0.0}, bed_given(false), energy_local(0.0),
+    natoms_computed(-1), box_computed{0.0, 0.0, 0.0, 0.0}, charges_computed(0),
+    qqrd2e_computed(0.0), boundary_computed(-1), bed_given(false), energy_local(0.0),
     energy_all(0.0), energy_summed(false), field(nullptr), eval_state(nullptr),
     near_delta(nullptr), nmax_ghost(0), list(nullptr), check_every(0), fresh(nullptr),
     nmax_check(0), check_last(0.0), check_max(0.0), check_num(0.0), check_den(0.0),
@@ -123,6 +148,7 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
     } else if (key == "images") {
       need(1);
       opts->images = utils::inumeric(FLERR, arg[iarg + 1], false, lmp);
+      periodic_keyword = key;
       if (opts->images < 0)
         error->all(FLERR, iarg + 1, "Fix coul/fmm images must be >= 0, got {}", arg[iarg + 1]);
       iarg += 2;
@@ -138,6 +164,7 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
       else
         error->all(FLERR, iarg + 1, "Fix coul/fmm farfield must be exact, average or none, got {}",
                    v);
+      periodic_keyword = key;
       iarg += 2;
     } else if (key == "bed") {
       need(2);
@@ -180,10 +207,6 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
       error->all(FLERR, iarg, "Unknown fix coul/fmm keyword: {}", key);
     }
   }
-  if (opts->images == 0 && opts->farfield == gcfmm::FarField::Exact)
-    error->all(FLERR,
-               "Fix coul/fmm farfield exact needs images >= 1 (the far-field kernel of "
-               "the exact lattice sum is singular inside the cell for images 0)");
   if (tolerance > 0.0 && every < 2)
     error->all(FLERR, "Fix coul/fmm tolerance {} needs every > 1 (the largest evaluation interval)",
                tolerance);
@@ -252,6 +275,43 @@ void FixCoulFMM::init()
     error->warning(FLERR,
                    "Fix coul/fmm is used together with a kspace style: Coulomb "
                    "interactions may be counted twice");
+  // a pair style with a Coulomb part (coul/cut, lj/cut/coul/long, ... or a hybrid sub-style)
+  // adds the same interactions again for the pairs within its cutoff
+  if (force->pair && comm->me == 0) {
+    int dim = 0;
+    if (force->pair->extract("cut_coul", dim) || force->pair_match("coul", 0))
+      error->warning(FLERR,
+                     "Fix coul/fmm {} is used together with pair style {}, which computes "
+                     "Coulomb interactions too: they are counted twice within its cutoff (use a "
+                     "pair style without a coul part)",
+                     id, force->pair_style);
+  }
+  if (opts->boundary == gcfmm::Boundary::Free) {
+    // no periodic images in free space: images and farfield mean nothing there
+    if (!periodic_keyword.empty() && comm->me == 0)
+      error->warning(FLERR,
+                     "Fix coul/fmm {}: keyword {} has no effect in free space (boundary f f f: "
+                     "no periodic images, the field is the exact sum over all charges)",
+                     id, periodic_keyword);
+  } else if (opts->images == 0 && opts->farfield == gcfmm::FarField::Exact) {
+    error->all(FLERR,
+               "Fix coul/fmm farfield exact with boundary p p f needs images >= 1, got images 0 "
+               "(the far-field kernel of the exact lattice sum is singular inside the cell "
+               "then): use images >= 1, or farfield average or none");
+  }
+  // the near refresh follows pairs through a neighbor list of cutoff near; with near beyond
+  // the periodic cell that list holds every pair with several of its images (LAMMPS then stops
+  // with a neighbor-list overflow that does not name near), and refreshing it every step costs
+  // more than evaluating every step (every 1)
+  if (near_cutoff > 0.0 && every > 1 && opts->boundary == gcfmm::Boundary::Periodic2D) {
+    const double cell = MIN(domain->xprd, domain->yprd);
+    if (near_cutoff >= cell)
+      error->all(FLERR,
+                 "Fix coul/fmm near {:g} must be smaller than the periodic cell (Lx = {:g}, "
+                 "Ly = {:g}): beyond it every pair is refreshed with several of its images, "
+                 "which costs more than every 1",
+                 near_cutoff, domain->xprd, domain->yprd);
+  }
   // the exact far field meets the requested accuracy only for cells close to square
   if (opts->boundary == gcfmm::Boundary::Periodic2D && opts->farfield == gcfmm::FarField::Exact) {
     const double aspect = MAX(domain->xprd, domain->yprd) / MIN(domain->xprd, domain->yprd);
@@ -428,9 +488,11 @@ void FixCoulFMM::post_force(int vflag)
   // evaluate on the steps that are multiples of the interval (every, or with tolerance the
   // adapted power of two: a schedule that does not depend on where a run starts, since the
   // interval is part of the restart state), and whenever atoms were added or removed (e.g. fix
-  // deposit): a new atom must feel, and exert, the Coulomb force from its first step
-  const bool due = last_computed < 0 || atom->natoms != natoms_computed ||
-      (step % stride == 0 && step != last_computed);
+  // deposit, evaporate): a new atom must feel, and exert, the Coulomb force from its first step
+  bool due = last_computed < 0 || (step % stride == 0 && step != last_computed);
+  // and whenever the charges (values, atom IDs), qqrd2e or the geometry changed since the last
+  // evaluation: a stored field would belong to other charges
+  if (!due) due = field_continuity() != Continuity::SAME;
   if (due) {
     compute_field(true);
     last_computed = step;
@@ -506,28 +568,41 @@ void FixCoulFMM::gather_charges()
 }
 
 /* ----------------------------------------------------------------------
-   how the stored evaluation relates to the atoms now: SAME atoms and charges in the same box,
-   atoms ADDED (e.g. by fix deposit) with the others unchanged, or NONE (nothing to continue)
+   how the stored evaluation relates to the atoms now: SAME charges (same IDs, same values; the
+   uncharged atoms do not matter) in the same geometry and units, charges ADDED (e.g. by fix
+   deposit) with all those of the evaluation still there and unchanged, or NONE (nothing to
+   continue: a charge changed (set, fix adapt), a charged atom left (fix evaporate), qqrd2e
+   (dielectric, units), the boundary or the periodic cell changed). Checked every step between
+   evaluations: an O(N) loop and one MPI_Allreduce of three integers. The sum of hashes is an
+   integer sum (modulo 2^64), so it is exact and the same however the atoms are distributed.
 ------------------------------------------------------------------------- */
 
 FixCoulFMM::Continuity FixCoulFMM::field_continuity()
 {
-  if (last_computed < 0 || atom->natoms < natoms_computed) return Continuity::NONE;
+  if (last_computed < 0) return Continuity::NONE;
+  if (boundary_computed != (int) opts->boundary || force->qqrd2e != qqrd2e_computed)
+    return Continuity::NONE;
   if (opts->boundary == gcfmm::Boundary::Periodic2D &&
       (domain->boxlo[0] != box_computed[0] || domain->boxlo[1] != box_computed[1] ||
        domain->xprd != box_computed[2] || domain->yprd != box_computed[3]))
     return Continuity::NONE;
-  // an atom created since the evaluation has charge 0 in eval_state (set_arrays)
-  const bool added = atom->natoms > natoms_computed;
-  int changed = 0, changed_all = 0;
+  // [0] the hash sum of the evaluation's charges still present, [1] atoms whose charge differs
+  // from the evaluation's (a created atom has charge 0 there, set_arrays), [2] those of them
+  // that were charged at the evaluation (changed, not added)
+  uint64_t local[3] = {0, 0, 0}, all[3];
+  const tagint *tag = atom->tag;
   for (int i = 0; i < atom->nlocal; i++) {
     const double q = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
     const double q_then = eval_state[i][EVAL_Q];
-    if (q != q_then && !(added && q_then == 0.0)) changed = 1;
+    if (q_then != 0.0) local[0] += charge_hash(tag[i], q_then);
+    if (q != q_then) {
+      local[1]++;
+      if (q_then != 0.0) local[2]++;
+    }
   }
-  MPI_Allreduce(&changed, &changed_all, 1, MPI_INT, MPI_MAX, world);
-  if (changed_all) return Continuity::NONE;
-  return added ? Continuity::ADDED : Continuity::SAME;
+  MPI_Allreduce(local, all, 3, MPI_UINT64_T, MPI_SUM, world);
+  if (all[0] != charges_computed || all[2] != 0) return Continuity::NONE;
+  return all[1] == 0 ? Continuity::SAME : Continuity::ADDED;
 }
 
 /* ----------------------------------------------------------------------
@@ -581,6 +656,13 @@ void FixCoulFMM::compute_field(bool with_slope)
     if (new_slope) st[EVAL_IN_SLOPE] = st[EVAL_Q] != 0.0 ? 1.0 : 0.0;
   }
   if (new_slope) slope_steps = steps;
+  // what the stored field belongs to (field_continuity)
+  uint64_t hash_local = 0;
+  for (int i = 0; i < nlocal; i++)
+    if (eval_state[i][EVAL_Q] != 0.0) hash_local += charge_hash(atom->tag[i], eval_state[i][EVAL_Q]);
+  MPI_Allreduce(&hash_local, &charges_computed, 1, MPI_UINT64_T, MPI_SUM, world);
+  qqrd2e_computed = force->qqrd2e;
+  boundary_computed = (int) opts->boundary;
   box_computed[0] = domain->boxlo[0];
   box_computed[1] = domain->boxlo[1];
   box_computed[2] = domain->xprd;
@@ -684,6 +766,13 @@ void FixCoulFMM::evaluate_into(double **out, int col)
     failure = fmt::format("atoms {} and {} are at the same position (closer than {:g} of the "
                           "solver's length unit): their Coulomb force is not defined",
                           gtag[e.first()], gtag[e.second()], gcfmm::kCoincidenceRadius);
+  } catch (gcfmm::FarFieldTooLarge &e) {
+    // the column's height (box or charges) sets the cost of the exact far field
+    failure = fmt::format("{}. In LAMMPS terms: the charged column (or the box in z, with "
+                          "boundary p p f) is {:.3g} times the cell side; use farfield average or "
+                          "none, a box or a wall that keeps the particles lower (a lid), or "
+                          "remove escaping particles (e.g. fix evaporate)",
+                          e.what(), e.height_over_side());
   } catch (std::exception &e) {
     failure = e.what();
     if (failure.empty()) failure = "unknown error";
@@ -1035,33 +1124,51 @@ void FixCoulFMM::unpack_forward_comm(int n, int first, double *buf_in)
 }
 
 /* ----------------------------------------------------------------------
-   restart: the step, atom count and box of the last evaluation (global), the applied and the
+   restart: the step, atom count, box, charge checksum, qqrd2e and boundary of the last
+   evaluation (global), the applied and the
    evaluated field with the evaluation positions and charges (per atom)
 ------------------------------------------------------------------------- */
 
 void FixCoulFMM::write_restart(FILE *fp)
 {
   if (comm->me == 0) {
-    double list_out[10] = {(double) last_computed, (double) natoms_computed, box_computed[0],
-                           box_computed[1],        box_computed[2],          box_computed[3],
-                           (double) every,         tolerance,                (double) stride,
-                           slope_steps};
+    // the 64-bit checksum as two 32-bit halves (exact in doubles)
+    double list_out[RESTART_GLOBAL_SIZE] = {RESTART_FORMAT_CHECKSUM,
+                                            (double) last_computed,
+                                            (double) natoms_computed,
+                                            box_computed[0],
+                                            box_computed[1],
+                                            box_computed[2],
+                                            box_computed[3],
+                                            (double) every,
+                                            tolerance,
+                                            (double) stride,
+                                            slope_steps,
+                                            (double) (charges_computed >> 32),
+                                            (double) (charges_computed & 0xffffffffULL),
+                                            qqrd2e_computed,
+                                            (double) boundary_computed};
     int size = sizeof(list_out);
     fwrite(&size, sizeof(int), 1, fp);
-    fwrite(list_out, sizeof(double), 10, fp);
+    fwrite(list_out, sizeof(double), RESTART_GLOBAL_SIZE, fp);
   }
 }
 
 void FixCoulFMM::restart(char *buf)
 {
   auto *list_in = (double *) buf;
+  // a file without the charge checksum (older format): evaluate afresh
+  if (list_in[0] != RESTART_FORMAT_CHECKSUM) return;
   // a different every or tolerance gives a different schedule: evaluate afresh
-  if ((int) list_in[6] != every || list_in[7] != tolerance) return;
-  stride = (int) list_in[8];
-  slope_steps = list_in[9];
-  last_computed = (bigint) list_in[0];
-  natoms_computed = (bigint) list_in[1];
-  for (int k = 0; k < 4; k++) box_computed[k] = list_in[2 + k];
+  if ((int) list_in[7] != every || list_in[8] != tolerance) return;
+  stride = (int) list_in[9];
+  slope_steps = list_in[10];
+  last_computed = (bigint) list_in[1];
+  natoms_computed = (bigint) list_in[2];
+  for (int k = 0; k < 4; k++) box_computed[k] = list_in[3 + k];
+  charges_computed = ((uint64_t) list_in[11] << 32) | (uint64_t) list_in[12];
+  qqrd2e_computed = list_in[13];
+  boundary_computed = (int) list_in[14];
 }
 
 int FixCoulFMM::pack_restart(int i, double *buf_out)

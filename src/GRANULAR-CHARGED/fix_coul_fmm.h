@@ -18,7 +18,9 @@ FixStyle(coul/fmm,FixCoulFMM);
 
 #include "fix.h"
 
+#include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace gcfmm {
@@ -72,9 +74,13 @@ class FixCoulFMM : public Fix {
   bool extrapolate;          // between evaluations extrapolate the far part linearly
   double near_cutoff;        // pairs closer than this are refreshed every step (0: off)
   bigint last_computed;      // step of the last FMM evaluation (-1: none yet)
-  bigint natoms_computed;    // atom count at that evaluation (atoms added -> recompute)
+  bigint natoms_computed;    // atom count at that evaluation (restart files; not a trigger)
   double box_computed[4];    // xlo, ylo, xprd, yprd at that evaluation
+  uint64_t charges_computed;    // sum of hash(ID, q) over the charged atoms at that evaluation
+  double qqrd2e_computed;       // force->qqrd2e (units, dielectric) at that evaluation
+  int boundary_computed;        // the gcfmm::Boundary of that evaluation (-1: none)
   bool bed_given;            // bed zlo/zhi given by the user (farfield average)
+  std::string periodic_keyword;    // last of images/farfield given (ignored in free space)
   double energy_local, energy_all;
   bool energy_summed;
   double **field;    // per atom: Ex, Ey, Ez, potential (force/charge, energy/charge)

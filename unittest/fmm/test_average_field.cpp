@@ -17,7 +17,7 @@ using namespace gcfmm;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+// kPi: gcfmm/types.hpp
 
 // Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_n, enough for n <= 64)
 void gauss_legendre(int n, std::vector<double> &x, std::vector<double> &w) {

@@ -12,13 +12,14 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
 #include <vector>
 
 using namespace gcfmm;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+// kPi: gcfmm/types.hpp
 
 // ---------------------------------------------------------------------------------------
 // Independent reference: 2D Ewald field and potential of a unit charge, alpha = 2.5 / lmin,
@@ -716,6 +717,36 @@ TEST(PeriodicFarField, DISABLED_AspectScan) {
                   f.order_xy(), f.boxes(), f.memory_bytes() / 1e6, e, f.estimated_error());
     }
   }
+}
+
+// issue 28, item 5: the set-up's cost grows linearly with the column height (H/L = 300 took
+// 16 s and 1.7 GB, 1e4 was killed by the out-of-memory killer, 1e5 threw std::bad_alloc): a
+// column beyond kMaxSetupBytes is refused before anything is allocated, quickly, with the
+// cost in the message, and the object stays as it was. The estimate itself is checked against
+// the memory a set-up holds (its dense blocks are a lower bound of the estimate).
+TEST(PeriodicFarField, TallColumnRefusedBeforeAllocating) {
+  const double l = 10;
+  for (double hl : {1e4, 1e5, 1e9}) {
+    PeriodicFarField f;
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      f.setup(0, 0, l, l, 0, hl * l, 1, 1e-4);
+      ADD_FAILURE() << "H/L = " << hl << " accepted";
+    } catch (const FarFieldTooLarge &e) {
+      EXPECT_GT(e.bytes(), PeriodicFarField::kMaxSetupBytes);
+      EXPECT_NEAR(e.height_over_side(), 1.2 * hl + 0.2, 1e-9 * hl);
+      EXPECT_NE(std::string(e.what()).find("cell sides high needs"), std::string::npos) << e.what();
+    }
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_LT(s, 0.5) << "H/L = " << hl << ": the refusal must come before the work";
+    EXPECT_FALSE(f.ready());
+  }
+  // a column within the limit is set up; what it holds is within the estimate
+  PeriodicFarField f;
+  f.setup(0, 0, l, l, 0, 20 * l, 1, 1e-4);
+  const double est = PeriodicFarField::setup_bytes(l, l, 0, 20 * l, f.order_xy(), f.order_z(), l);
+  EXPECT_LT(static_cast<double>(f.memory_bytes()), est);
+  EXPECT_GT(est, 1e6);
 }
 
 // Rectangular cells up to the supported aspect ratio 2 and tall columns (H / L = 50) meet the

@@ -467,6 +467,42 @@ TEST(PackingComputes, PeriodicZ)
   }
 }
 
+// issue 28, item 4: slab bounds far outside a box periodic in z. The remainder beyond whole
+// periods comes from the bounds wrapped into the box, and phi from the share of whole periods
+// (not their count): a slab of +-1e300 in a box 1e-9 thick (2e309 periods, which overflowed to
+// inf before) gives the same phi as +-1e10; bounds whose distance is not a finite number are
+// an error (before: NaN without a word).
+TEST(PackingComputes, SlabFarBeyondPeriodicBox)
+{
+  auto phi_of = [](double lo, double hi) {
+    Lmp l;
+    l.cmds({"units si", "atom_style sphere", "boundary p p p",
+            "region box block 0 28e-6 0 28e-6 0 1e-9", "create_box 1 box",
+            "create_atoms 1 random 50 5 NULL", "set group all diameter 2e-6",
+            fmt::format("compute phi all packing/slab {:.17g} {:.17g}", lo, hi), "run 0 post no"});
+    return cscalar(l, "phi");
+  };
+  const double ref = phi_of(-1e10, 1e10);
+  EXPECT_TRUE(std::isfinite(ref));
+  // the whole box (and whole periods of it) is phi of the box: 50 spheres of 4/3 pi (1e-6)^3
+  // each, all whole periods; relative round-off of the sums ~1e-15
+  const double box = 50 * 4.0 / 3.0 * M_PI * 1e-18 / (28e-6 * 28e-6 * 1e-9);
+  EXPECT_NEAR(phi_of(0.0, 1e-9), box, 1e-12 * box);
+  EXPECT_NEAR(ref, box, 1e-9 * box);
+  EXPECT_NEAR(phi_of(-1e300, 1e300), box, 1e-9 * box);
+  Lmp l;
+  l.cmds({"units si", "atom_style sphere", "boundary p p p",
+          "region box block 0 28e-6 0 28e-6 0 1e-9", "create_box 1 box",
+          "create_atoms 1 random 50 5 NULL", "set group all diameter 2e-6",
+          "compute phi all packing/slab -1.5e308 1.5e308", "thermo_style custom step c_phi"});
+  try {
+    l.cmd("run 0 post no");
+    ADD_FAILURE() << "no error for a slab of infinite thickness, phi = " << cscalar(l, "phi");
+  } catch (LAMMPS_NS::LAMMPSException &e) {
+    expect_match(e.what(), "Compute packing/slab phi: slab -1.5e\\+308 .. 1.5e\\+308 is not finite");
+  }
+}
+
 // pair hybrid: "active" reads the granular sub-style's contact flags; a pair handled by another
 // sub-style (zero) is a geometric contact but never an active one. Pair 1-2 (granular) is pulled
 // to a gap of 0.5 delta_C (still held), pair 3-4 (zero) overlaps by 1 nm throughout.

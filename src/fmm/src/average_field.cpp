@@ -12,8 +12,6 @@ namespace gcfmm {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 // ln(a + r) with r = sqrt(a^2 + s2), s2 = b^2 + c^2 >= 0, without cancellation for a < 0
 inline double log_plus(double a, double r, double s2) {
   if (a >= 0) return std::log(a + r);

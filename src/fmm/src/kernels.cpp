@@ -15,8 +15,10 @@ namespace gcfmm {
 
 namespace {
 
-// Portable kernel: exact 1/sqrt, vectorised by the compiler (omp simd reduction); compiled
-// for each path of simd.hpp (p2p_loop_generic, _avx2, _avx512).
+// Portable kernel (the Generic path, and every path where the x86 kernels below do not exist):
+// exact 1/sqrt, vectorised over the sources by the compiler (omp simd reduction). Its sums run
+// in another order than those of the x86 kernels (over sources, not over targets), so it is
+// the reference they are tested against (test_p2p), not an instance of their loop.
 GCFMM_ALWAYS_INLINE void p2p_loop(std::size_t nt, const double *__restrict xt, const double *__restrict yt,
                         const double *__restrict zt, std::size_t ns, const double *__restrict xs,
                         const double *__restrict ys, const double *__restrict zs, const double *__restrict qs,
@@ -49,104 +51,137 @@ GCFMM_ALWAYS_INLINE void p2p_loop(std::size_t nt, const double *__restrict xt, c
    const double *ys, const double *zs, const double *qs, double sx, double sy, double sz, double *pot, double *ex, \
    double *ey, double *ez, double r2_min)
 #define GCFMM_P2P_ARGS (nt, xt, yt, zt, ns, xs, ys, zs, qs, sx, sy, sz, pot, ex, ey, ez, r2_min)
-GCFMM_DEFINE_SIMD_PATHS(void, p2p_loop, GCFMM_P2P_PARAMS, p2p_loop, GCFMM_P2P_ARGS)
+using p2p_loop_fn = void(*) GCFMM_P2P_PARAMS;
 
 #if GCFMM_X86_DISPATCH
-// AVX-512 kernel, vectorised over 8 targets (masked tail) with the sources broadcast one by
-// one: no horizontal reductions, and each lane (target) sees exactly the same sequence of
-// operations wherever it sits, so a target's result depends only on its position and the
-// source range. 1/sqrt(r2) comes from the 14-bit hardware estimate (vrsqrt14pd) refined by
-// two Newton steps y <- y (3 - r2 y^2) / 2 (relative error 2^-14 -> 2^-28 -> ~1e-16),
-// because vsqrtpd + vdivpd are much slower (doc/benchmarks.md, "P2P kernels").
-GCFMM_TARGET_AVX512 void p2p_rsqrt_avx512(std::size_t nt, const double *__restrict xt, const double *__restrict yt,
-                       const double *__restrict zt, std::size_t ns, const double *__restrict xs,
-                       const double *__restrict ys, const double *__restrict zs, const double *__restrict qs,
-                       double sx, double sy, double sz, double *__restrict pot, double *__restrict ex,
-                       double *__restrict ey, double *__restrict ez, double r2_min) {
-  const __m512d rmin2 = _mm512_set1_pd(r2_min);
-  const __m512d half = _mm512_set1_pd(0.5), three_half = _mm512_set1_pd(1.5), zero = _mm512_setzero_pd();
-  for (std::size_t i = 0; i < nt; i += 8) {
-    const std::size_t left = nt - i;
-    const __mmask8 m = left >= 8 ? static_cast<__mmask8>(0xFF) : static_cast<__mmask8>((1u << left) - 1u);
-    const __m512d xi = _mm512_sub_pd(_mm512_maskz_loadu_pd(m, xt + i), _mm512_set1_pd(sx));
-    const __m512d yi = _mm512_sub_pd(_mm512_maskz_loadu_pd(m, yt + i), _mm512_set1_pd(sy));
-    const __m512d zi = _mm512_sub_pd(_mm512_maskz_loadu_pd(m, zt + i), _mm512_set1_pd(sz));
-    __m512d p = zero, fx = zero, fy = zero, fz = zero;
+// The x86 kernels (AVX2, AVX-512): one loop, vectorised over the W targets of a register
+// (masked tail) with the sources broadcast one by one: no horizontal reductions, and each lane
+// (target) sees exactly the same sequence of operations wherever it sits, so a target's result
+// depends only on its position and the source range. 1/sqrt(r2) comes from a hardware estimate
+// refined by Newton steps y <- y (3 - r2 y^2) / 2, because vsqrtpd + vdivpd are much slower
+// (doc/benchmarks.md, "P2P kernels"); the estimate is the only difference between the two ISAs
+// (Reg::rsqrt). The loop is a template over the register traits; the kernels that instantiate
+// it carry the ISA's target attribute and `flatten`, which inlines the traits (compiled for
+// that ISA) into them.
+// GCC notes that vectors passed by value change the ABI of a function compiled without the
+// ISA; the loop and its traits are only ever inlined into the kernel of their ISA (flatten),
+// so no such call exists
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+template <class Reg>
+inline void p2p_rsqrt(std::size_t nt, const double *__restrict xt, const double *__restrict yt,
+                      const double *__restrict zt, std::size_t ns, const double *__restrict xs,
+                      const double *__restrict ys, const double *__restrict zs, const double *__restrict qs,
+                      double sx, double sy, double sz, double *__restrict pot, double *__restrict ex,
+                      double *__restrict ey, double *__restrict ez, double r2_min) {
+  using V = typename Reg::V;
+  const V rmin2 = Reg::set1(r2_min), zero = Reg::set1(0.0);
+  for (std::size_t i = 0; i < nt; i += Reg::kWidth) {
+    const typename Reg::Mask m = Reg::tail(nt - i);
+    const V xi = Reg::sub(Reg::load(m, xt + i), Reg::set1(sx));
+    const V yi = Reg::sub(Reg::load(m, yt + i), Reg::set1(sy));
+    const V zi = Reg::sub(Reg::load(m, zt + i), Reg::set1(sz));
+    V p = zero, fx = zero, fy = zero, fz = zero;
     for (std::size_t j = 0; j < ns; ++j) {
-      const __m512d dx = _mm512_sub_pd(xi, _mm512_set1_pd(xs[j]));
-      const __m512d dy = _mm512_sub_pd(yi, _mm512_set1_pd(ys[j]));
-      const __m512d dz = _mm512_sub_pd(zi, _mm512_set1_pd(zs[j]));
-      const __m512d q = _mm512_set1_pd(qs[j]);
-      const __m512d r2 = _mm512_fmadd_pd(dx, dx, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dz, dz)));
-      const __mmask8 nz = _mm512_cmp_pd_mask(r2, rmin2, _CMP_GT_OQ);  // drop the self term and coincident pairs
-      __m512d y = _mm512_maskz_rsqrt14_pd(nz, r2);
-      const __m512d hr2 = _mm512_mul_pd(half, r2);
-      y = _mm512_mul_pd(y, _mm512_fnmadd_pd(hr2, _mm512_mul_pd(y, y), three_half));
-      y = _mm512_mul_pd(y, _mm512_fnmadd_pd(hr2, _mm512_mul_pd(y, y), three_half));
-      const __m512d qi = _mm512_mul_pd(q, y);
-      const __m512d qi3 = _mm512_mul_pd(qi, _mm512_mul_pd(y, y));
-      p = _mm512_add_pd(p, qi);
-      fx = _mm512_fmadd_pd(dx, qi3, fx);
-      fy = _mm512_fmadd_pd(dy, qi3, fy);
-      fz = _mm512_fmadd_pd(dz, qi3, fz);
+      const V dx = Reg::sub(xi, Reg::set1(xs[j]));
+      const V dy = Reg::sub(yi, Reg::set1(ys[j]));
+      const V dz = Reg::sub(zi, Reg::set1(zs[j]));
+      const V r2 = Reg::fmadd(dx, dx, Reg::fmadd(dy, dy, Reg::mul(dz, dz)));
+      const V y = Reg::rsqrt(r2, rmin2);    // 0 for the self term and coincident pairs
+      const V qi = Reg::mul(Reg::set1(qs[j]), y);
+      const V qi3 = Reg::mul(qi, Reg::mul(y, y));
+      p = Reg::add(p, qi);
+      fx = Reg::fmadd(dx, qi3, fx);
+      fy = Reg::fmadd(dy, qi3, fy);
+      fz = Reg::fmadd(dz, qi3, fz);
     }
-    _mm512_mask_storeu_pd(pot + i, m, _mm512_add_pd(_mm512_maskz_loadu_pd(m, pot + i), p));
-    _mm512_mask_storeu_pd(ex + i, m, _mm512_add_pd(_mm512_maskz_loadu_pd(m, ex + i), fx));
-    _mm512_mask_storeu_pd(ey + i, m, _mm512_add_pd(_mm512_maskz_loadu_pd(m, ey + i), fy));
-    _mm512_mask_storeu_pd(ez + i, m, _mm512_add_pd(_mm512_maskz_loadu_pd(m, ez + i), fz));
+    Reg::add_store(m, pot + i, p);
+    Reg::add_store(m, ex + i, fx);
+    Reg::add_store(m, ey + i, fy);
+    Reg::add_store(m, ez + i, fz);
   }
 }
-// AVX2 kernel, the same structure as the AVX-512 one over 4 targets: 1/sqrt(r2) from the
-// single-precision estimate (vrsqrtps, relative error <= 1.5 2^-12) refined by three Newton
-// steps (2^-12 -> 2^-23 -> 2^-45 -> round-off), because vsqrtpd + vdivpd are slow
-// (doc/benchmarks.md, "P2P kernels"). Lanes whose r2 is outside the normal single-precision
-// range (below 1e-36 or above 1e36, where the estimate does not exist) take the exact
-// 1/sqrt instead.
-GCFMM_TARGET_AVX2 void p2p_rsqrt_avx2(std::size_t nt, const double *__restrict xt, const double *__restrict yt,
-                                      const double *__restrict zt, std::size_t ns, const double *__restrict xs,
-                                      const double *__restrict ys, const double *__restrict zs,
-                                      const double *__restrict qs, double sx, double sy, double sz,
-                                      double *__restrict pot, double *__restrict ex, double *__restrict ey,
-                                      double *__restrict ez, double r2_min) {
-  const __m256d rmin2 = _mm256_set1_pd(r2_min), half = _mm256_set1_pd(0.5), three_half = _mm256_set1_pd(1.5);
-  const __m256d lo = _mm256_set1_pd(1e-36), hi = _mm256_set1_pd(1e36), one = _mm256_set1_pd(1.0);
-  const __m256d zero = _mm256_setzero_pd();
-  for (std::size_t i = 0; i < nt; i += 4) {
-    const std::size_t left = nt - i;
+
+// one Newton step for 1/sqrt(r2), hr2 = r2 / 2: y (3/2 - hr2 y^2), its relative error squared
+#define GCFMM_NEWTON(fnmadd, mul, y, hr2, three_half) y = mul(y, fnmadd(hr2, mul(y, y), three_half))
+
+// AVX-512, 8 targets: the 14-bit estimate (vrsqrt14pd, zero where the pair is dropped) and two
+// Newton steps (2^-14 -> 2^-28 -> ~1e-16)
+struct Avx512 {
+  using V = __m512d;
+  using Mask = __mmask8;
+  static constexpr std::size_t kWidth = 8;
+  GCFMM_TARGET_AVX512 static Mask tail(std::size_t left) {
+    return left >= 8 ? static_cast<__mmask8>(0xFF) : static_cast<__mmask8>((1u << left) - 1u);
+  }
+  GCFMM_TARGET_AVX512 static V set1(double v) { return _mm512_set1_pd(v); }
+  GCFMM_TARGET_AVX512 static V load(Mask m, const double *p) { return _mm512_maskz_loadu_pd(m, p); }
+  GCFMM_TARGET_AVX512 static void add_store(Mask m, double *p, V v) {
+    _mm512_mask_storeu_pd(p, m, _mm512_add_pd(_mm512_maskz_loadu_pd(m, p), v));
+  }
+  GCFMM_TARGET_AVX512 static V add(V a, V b) { return _mm512_add_pd(a, b); }
+  GCFMM_TARGET_AVX512 static V sub(V a, V b) { return _mm512_sub_pd(a, b); }
+  GCFMM_TARGET_AVX512 static V mul(V a, V b) { return _mm512_mul_pd(a, b); }
+  GCFMM_TARGET_AVX512 static V fmadd(V a, V b, V c) { return _mm512_fmadd_pd(a, b, c); }
+  GCFMM_TARGET_AVX512 static V rsqrt(V r2, V rmin2) {
+    const __m512d half = _mm512_set1_pd(0.5), three_half = _mm512_set1_pd(1.5);
+    const __mmask8 keep = _mm512_cmp_pd_mask(r2, rmin2, _CMP_GT_OQ);
+    __m512d y = _mm512_maskz_rsqrt14_pd(keep, r2);
+    const __m512d hr2 = _mm512_mul_pd(half, r2);
+    GCFMM_NEWTON(_mm512_fnmadd_pd, _mm512_mul_pd, y, hr2, three_half);
+    GCFMM_NEWTON(_mm512_fnmadd_pd, _mm512_mul_pd, y, hr2, three_half);
+    return y;
+  }
+};
+
+// AVX2, 4 targets: the single-precision estimate (vrsqrtps, relative error <= 1.5 2^-12) and
+// three Newton steps (2^-12 -> 2^-23 -> 2^-45 -> round-off). Lanes whose r2 is outside the
+// normal single-precision range (below 1e-36 or above 1e36, where the estimate does not exist)
+// take the exact 1/sqrt instead.
+struct Avx2 {
+  using V = __m256d;
+  using Mask = __m256i;
+  static constexpr std::size_t kWidth = 4;
+  GCFMM_TARGET_AVX2 static Mask tail(std::size_t left) {
     const long long all = -1;
-    const __m256i m = _mm256_set_epi64x(left > 3 ? all : 0, left > 2 ? all : 0, left > 1 ? all : 0, all);
-    const __m256d xi = _mm256_sub_pd(_mm256_maskload_pd(xt + i, m), _mm256_set1_pd(sx));
-    const __m256d yi = _mm256_sub_pd(_mm256_maskload_pd(yt + i, m), _mm256_set1_pd(sy));
-    const __m256d zi = _mm256_sub_pd(_mm256_maskload_pd(zt + i, m), _mm256_set1_pd(sz));
-    __m256d p = zero, fx = zero, fy = zero, fz = zero;
-    for (std::size_t j = 0; j < ns; ++j) {
-      const __m256d dx = _mm256_sub_pd(xi, _mm256_set1_pd(xs[j]));
-      const __m256d dy = _mm256_sub_pd(yi, _mm256_set1_pd(ys[j]));
-      const __m256d dz = _mm256_sub_pd(zi, _mm256_set1_pd(zs[j]));
-      const __m256d r2 = _mm256_fmadd_pd(dx, dx, _mm256_fmadd_pd(dy, dy, _mm256_mul_pd(dz, dz)));
-      const __m256d keep = _mm256_cmp_pd(r2, rmin2, _CMP_GT_OQ);  // drop the self term and coincident pairs
-      __m256d y = _mm256_cvtps_pd(_mm_rsqrt_ps(_mm256_cvtpd_ps(r2)));
-      const __m256d hr2 = _mm256_mul_pd(half, r2);
-      y = _mm256_mul_pd(y, _mm256_fnmadd_pd(hr2, _mm256_mul_pd(y, y), three_half));
-      y = _mm256_mul_pd(y, _mm256_fnmadd_pd(hr2, _mm256_mul_pd(y, y), three_half));
-      y = _mm256_mul_pd(y, _mm256_fnmadd_pd(hr2, _mm256_mul_pd(y, y), three_half));
-      const __m256d out = _mm256_or_pd(_mm256_cmp_pd(r2, lo, _CMP_LT_OQ), _mm256_cmp_pd(r2, hi, _CMP_GT_OQ));
-      if (_mm256_movemask_pd(_mm256_and_pd(out, keep))) y = _mm256_blendv_pd(y, _mm256_div_pd(one, _mm256_sqrt_pd(r2)), out);
-      y = _mm256_and_pd(y, keep);
-      const __m256d qi = _mm256_mul_pd(_mm256_set1_pd(qs[j]), y);
-      const __m256d qi3 = _mm256_mul_pd(qi, _mm256_mul_pd(y, y));
-      p = _mm256_add_pd(p, qi);
-      fx = _mm256_fmadd_pd(dx, qi3, fx);
-      fy = _mm256_fmadd_pd(dy, qi3, fy);
-      fz = _mm256_fmadd_pd(dz, qi3, fz);
-    }
-    _mm256_maskstore_pd(pot + i, m, _mm256_add_pd(_mm256_maskload_pd(pot + i, m), p));
-    _mm256_maskstore_pd(ex + i, m, _mm256_add_pd(_mm256_maskload_pd(ex + i, m), fx));
-    _mm256_maskstore_pd(ey + i, m, _mm256_add_pd(_mm256_maskload_pd(ey + i, m), fy));
-    _mm256_maskstore_pd(ez + i, m, _mm256_add_pd(_mm256_maskload_pd(ez + i, m), fz));
+    return _mm256_set_epi64x(left > 3 ? all : 0, left > 2 ? all : 0, left > 1 ? all : 0, all);
   }
+  GCFMM_TARGET_AVX2 static V set1(double v) { return _mm256_set1_pd(v); }
+  GCFMM_TARGET_AVX2 static V load(Mask m, const double *p) { return _mm256_maskload_pd(p, m); }
+  GCFMM_TARGET_AVX2 static void add_store(Mask m, double *p, V v) {
+    _mm256_maskstore_pd(p, m, _mm256_add_pd(_mm256_maskload_pd(p, m), v));
+  }
+  GCFMM_TARGET_AVX2 static V add(V a, V b) { return _mm256_add_pd(a, b); }
+  GCFMM_TARGET_AVX2 static V sub(V a, V b) { return _mm256_sub_pd(a, b); }
+  GCFMM_TARGET_AVX2 static V mul(V a, V b) { return _mm256_mul_pd(a, b); }
+  GCFMM_TARGET_AVX2 static V fmadd(V a, V b, V c) { return _mm256_fmadd_pd(a, b, c); }
+  GCFMM_TARGET_AVX2 static V rsqrt(V r2, V rmin2) {
+    const __m256d half = _mm256_set1_pd(0.5), three_half = _mm256_set1_pd(1.5);
+    const __m256d lo = _mm256_set1_pd(1e-36), hi = _mm256_set1_pd(1e36), one = _mm256_set1_pd(1.0);
+    const __m256d keep = _mm256_cmp_pd(r2, rmin2, _CMP_GT_OQ);
+    __m256d y = _mm256_cvtps_pd(_mm_rsqrt_ps(_mm256_cvtpd_ps(r2)));
+    const __m256d hr2 = _mm256_mul_pd(half, r2);
+    GCFMM_NEWTON(_mm256_fnmadd_pd, _mm256_mul_pd, y, hr2, three_half);
+    GCFMM_NEWTON(_mm256_fnmadd_pd, _mm256_mul_pd, y, hr2, three_half);
+    GCFMM_NEWTON(_mm256_fnmadd_pd, _mm256_mul_pd, y, hr2, three_half);
+    const __m256d out = _mm256_or_pd(_mm256_cmp_pd(r2, lo, _CMP_LT_OQ), _mm256_cmp_pd(r2, hi, _CMP_GT_OQ));
+    if (_mm256_movemask_pd(_mm256_and_pd(out, keep))) y = _mm256_blendv_pd(y, _mm256_div_pd(one, _mm256_sqrt_pd(r2)), out);
+    return _mm256_and_pd(y, keep);
+  }
+};
+#undef GCFMM_NEWTON
+
+__attribute__((flatten)) GCFMM_TARGET_AVX512 void p2p_rsqrt_avx512 GCFMM_P2P_PARAMS {
+  p2p_rsqrt<Avx512> GCFMM_P2P_ARGS;
 }
+__attribute__((flatten)) GCFMM_TARGET_AVX2 void p2p_rsqrt_avx2 GCFMM_P2P_PARAMS {
+  p2p_rsqrt<Avx2> GCFMM_P2P_ARGS;
+}
+#pragma GCC diagnostic pop
 #endif
+
+// the portable kernel (above)
+void p2p_loop_generic GCFMM_P2P_PARAMS { p2p_loop GCFMM_P2P_ARGS; }
 
 // the P2P kernel of a path: the loop for Generic, the rsqrt kernels for AVX2 and AVX-512
 p2p_loop_fn p2p_kernel(SimdPath path) {
@@ -154,7 +189,8 @@ p2p_loop_fn p2p_kernel(SimdPath path) {
   if (path == SimdPath::AVX512) return p2p_rsqrt_avx512;
   if (path == SimdPath::AVX2) return p2p_rsqrt_avx2;
 #endif
-  return p2p_loop_for(path);
+  (void) path;
+  return p2p_loop_generic;
 }
 
 }  // namespace

@@ -8,11 +8,12 @@
 #include <stdexcept>
 #include <vector>
 
+#include "gcfmm/types.hpp"
+
 namespace gcfmm {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kTwoOverSqrtPi = 1.12837916709551257390;  // 2 / sqrt(pi)
 constexpr double kEwaldAlphaL = 4.0;   // alpha * min(lx, ly): erfc(1.5 * 4) = 2e-17 beyond 3x3 cells
 constexpr double kEwaldKmax = 13.0;    // |k| <= 13 alpha: erfc(6.5) = 4e-20

@@ -9,6 +9,8 @@
 
 #include <cstddef>
 
+#include "gcfmm/types.hpp"
+
 namespace gcfmm {
 
 /**

@@ -9,11 +9,32 @@
 #define GCFMM_FAR_FIELD_HPP
 
 #include <cstddef>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "gcfmm/types.hpp"
 
 namespace gcfmm {
+
+/** @brief Thrown by PeriodicFarField::setup() / setup_explicit() BEFORE anything is allocated
+ *  when the operator of the column would need more than PeriodicFarField::kMaxSetupBytes:
+ *  the cost grows linearly with the column height H in units of the cell side L (boxes of
+ *  height <= L). bytes() is the estimate, boxes() the number of boxes, height_over_side() H/L
+ *  of the stored (padded) column. */
+class FarFieldTooLarge : public std::runtime_error {
+ public:
+  FarFieldTooLarge(double bytes, int boxes, double height_over_side, const std::string &what)
+      : std::runtime_error(what), bytes_(bytes), boxes_(boxes), hl_(height_over_side) {}
+  double bytes() const { return bytes_; }                //!< estimated peak bytes of the set-up
+  int boxes() const { return boxes_; }                   //!< boxes of the column
+  double height_over_side() const { return hl_; }        //!< stored column height / min(lx, ly)
+
+ private:
+  double bytes_;
+  int boxes_;
+  double hl_;
+};
 
 /**
  * @brief Field of all image cells beyond `images` shells (max(|nx|,|ny|) > images), the
@@ -46,7 +67,7 @@ namespace gcfmm {
 class PeriodicFarField {
  public:
   //! Largest cell aspect ratio max(lx, ly) / min(lx, ly) accepted by setup(); column heights
-  //! are not limited (the column is split into boxes; H / L = 50 is tested).
+  //! are limited by their cost only (kMaxSetupBytes; H / L = 160 is tested).
   static constexpr double kMaxAspect = 2.0;
 
   //! setup() truncates each operator block's low-rank factorisation at this times the
@@ -56,6 +77,22 @@ class PeriodicFarField {
   //! largest block (p^2 pz / 4 rows) that setup() factorises; larger ones stay dense
   static constexpr int kMaxCompressedBlock = 256;
 
+  //! Largest peak memory of a set-up (dense operator blocks, kernel table and node
+  //! differences, held at once before the blocks are compressed; setup_bytes() tracks the
+  //! measured peak RSS within 3%), per caller (each MPI rank of the LAMMPS fix holds a copy).
+  //! 1 GiB admits every tested column (H/L = 160 at accuracy 1e-4: 116 MB; H/L = 50 at 1e-6:
+  //! 287 MB; H/L = 160 at 1e-6: 0.9 GB, 3.3 s) and columns up to H/L ~ 1400 at the default
+  //! 1e-4 (H/L = 1000: 0.71 GB, 5.4 s), ~190 at 1e-6, ~1e4 at 1e-2; beyond, the cost grows
+  //! linearly with H (a column refused here: H/L = 1e5 at 1e-4 was killed by the
+  //! out-of-memory killer at 22.5 GB after 241 s). Then setup() throws FarFieldTooLarge
+  //! (doc/fmm-far-field.md, "Column height").
+  static constexpr double kMaxSetupBytes = 1024.0 * 1024 * 1024;
+
+  /// @brief Estimated peak bytes of setup_explicit() for these parameters (what
+  /// kMaxSetupBytes limits); `boxes` receives the number of boxes of the padded column.
+  static double setup_bytes(double lx, double ly, double zlo, double zhi, int pxy, int pz,
+                            double hz_max, int *boxes = nullptr);
+
   /**
    * @brief Precompute the operator.
    * @param x0,y0,lx,ly primary cell [x0,x0+lx) x [y0,y0+ly)
@@ -64,7 +101,8 @@ class PeriodicFarField {
    * @param images      near-block shells handled by the caller (>= 1)
    * @param accuracy    requested relative RMS accuracy of the far field, in [1e-8, 1)
    * @throws std::invalid_argument on bad arguments, and for cells with
-   *         max(lx, ly) / min(lx, ly) > kMaxAspect (the accuracy is not met there)
+   *         max(lx, ly) / min(lx, ly) > kMaxAspect (the accuracy is not met there);
+   *         FarFieldTooLarge (before allocating) if setup_bytes() exceeds kMaxSetupBytes
    */
   void setup(double x0, double y0, double lx, double ly, double zlo, double zhi, int images,
              double accuracy);
@@ -121,6 +159,12 @@ class PeriodicFarField {
                    std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
                    double *ez) const;
   double sample_error() const;
+  // the sampled kernel error times this is the estimate (the ratio of the far-field error to
+  // the sample in the calibration scan: doc/fmm-far-field.md)
+  static constexpr double kSampleToError = 20.0;
+  // the uncompressed operator of a column (setup and setup_explicit; no error estimate)
+  void build_operator(double x0, double y0, double lx, double ly, double zlo, double zhi,
+                      int images, int pxy, int pz, double hz_max);
   // replace each block by a truncated low-rank factorisation U W where that halves the work
   void compress(double rel_tol);
 

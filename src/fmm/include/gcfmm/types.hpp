@@ -8,6 +8,9 @@
 
 namespace gcfmm {
 
+//! pi, for every source file of the library (one definition)
+inline constexpr double kPi = 3.14159265358979323846;
+
 /// Sums `count` doubles element by element over all work partitions, in place, the same result
 /// on every partition (an MPI_Allreduce with MPI_SUM, for example). Given to evaluate(), it
 /// lets the partitions split work each would otherwise repeat; every element it sums is
