@@ -19,7 +19,8 @@ from conftest import SRC
 
 TINY = ["--N", 5, "--seed", 1, "--var", "L_rp", 6, "--var", "H_rp", 30, "--no-render"]
 # ke_stop 0: no stop before the settling time settle_max r_p / U_0 (~330 steps per unit)
-LONG = TINY + ["--var", "ke_stop", 0, "--var", "settle_max", 300]       # ~2 s
+LONG = TINY + ["--var", "ke_stop", 0, "--var", "settle_max", 3000]      # ~20 s: outlasts a second
+# command's start-up on a loaded machine (300, ~2 s, did not under a parallel ctest)
 ENDLESS = TINY + ["--var", "ke_stop", 0, "--var", "settle_max", 100000]  # ~10 min: killed
 
 
@@ -81,7 +82,7 @@ def test_two_commands_on_one_run_take_turns(build_dir, tmp_path):
     finds the run finished. Both exit 0 and the folder holds one complete run."""
     args = ["run", "--out", tmp_path / "runs", *LONG]
     first = _popen(build_dir, args, tmp_path)
-    wd = tmp_path / "runs" / "rp2um_U1_g10mJ_q0_N5_s1_H_rp30_L_rp6_ke_stop0_settle_max300"
+    wd = tmp_path / "runs" / "rp2um_U1_g10mJ_q0_N5_s1_H_rp30_L_rp6_ke_stop0_settle_max3000"
     _wait_for(lambda: (wd / "log.lammps").exists() or first.poll() is not None, 60,
               "the first run's log.lammps")
     assert first.poll() is None, "the first run ended before the second started: make LONG longer"
