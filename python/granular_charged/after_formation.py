@@ -14,7 +14,7 @@ from pathlib import Path
 from . import tables
 from .deckfile import deck_variables
 from .params import ParamError, coulomb_to_adhesion
-from .runner import RunError, Runner, folder_lock, read_result, write_json
+from .runner import RunError, Runner, folder_lock, load_result_files, read_result, write_json
 
 DECK = "in.charged-after-formation"
 # the variables of a Table 2 run that are not the formed packing's: where it starts from, the
@@ -58,7 +58,7 @@ def run_table2(runner: Runner, formed: Path, qs, out: Path, extra: dict | None =
         rf = wd / "result.json"
         try:
             r = json.loads(rf.read_text())
-            if isinstance(r, dict) and all(k in r for k in ROW_KEYS):
+            if row_problem(r) is None:
                 r["dir"] = str(wd)
                 log.debug("table 2, q = %g: finished before", q)
                 return r
@@ -93,17 +93,10 @@ def run_table2(runner: Runner, formed: Path, qs, out: Path, extra: dict | None =
 def load_table2(folder: Path) -> list[dict]:
     """The finished Table 2 runs under folder/q*/ (with 'dir'); unreadable or incomplete ones
     are named in a warning and left out."""
-    rows = []
-    for f in sorted(Path(folder).glob("q*/result.json")):
-        try:
-            r = json.loads(f.read_text())
-        except (OSError, ValueError) as e:
-            log.warning("%s: not valid JSON (%s), ignored", f, e)
-            continue
-        missing = [k for k in ROW_KEYS if not isinstance(r, dict) or k not in r]
-        if missing:
-            log.warning("%s: keys missing: %s, ignored", f, ", ".join(missing))
-            continue
-        r["dir"] = str(f.parent)
-        rows.append(r)
-    return rows
+    return load_result_files(Path(folder).glob("q*/result.json"), row_problem)
+
+
+def row_problem(r) -> str | None:
+    """Why a Table 2 result.json cannot be used (None: it can): keys of a row missing."""
+    missing = [k for k in ROW_KEYS if not isinstance(r, dict) or k not in r]
+    return f"keys missing: {', '.join(missing)}" if missing else None

@@ -76,6 +76,26 @@ def result_problem(res) -> str | None:
     return None
 
 
+def load_result_files(files, problem=result_problem) -> list[dict]:
+    """The usable results among the JSON files ``files`` (sorted), each with 'dir' (its folder):
+    a file that is not valid JSON, or whose content has a problem (``problem(r)`` returns a
+    message instead of None), is named in a warning and left out."""
+    rows = []
+    for f in sorted(files):
+        try:
+            r = json.loads(Path(f).read_text())
+        except (OSError, ValueError) as e:
+            log.warning("%s: not valid JSON (%s), ignored", f, e)
+            continue
+        why = problem(r)
+        if why:
+            log.warning("%s: %s, ignored", f, why)
+            continue
+        r["dir"] = str(Path(f).parent)
+        rows.append(r)
+    return rows
+
+
 def read_result(path: Path) -> dict | None:
     """A complete, usable result.json of the current version, else None."""
     try:

@@ -8,7 +8,6 @@ The paper's full set (its Figs. 2, 3a-c, 5a-c, 9, 10; N = 2000, L = 28 r_p, hour
 from __future__ import annotations
 
 import itertools
-import json
 import logging
 import time
 from concurrent.futures import ThreadPoolExecutor, as_completed
@@ -19,7 +18,7 @@ from tqdm import tqdm
 from tqdm.contrib.logging import logging_redirect_tqdm
 
 from .params import DepositionParams
-from .runner import RunError, Runner, result_problem
+from .runner import RunError, Runner, load_result_files
 
 log = logging.getLogger(__name__)
 
@@ -156,19 +155,5 @@ def fmt(v, spec: str) -> str:
 def load_results(out: Path) -> list[dict]:
     """Every complete, usable result.json under out/*/ (with 'dir', its folder); the others are
     named in a warning and left out."""
-    res = []
-    for f in sorted(Path(out).glob("*/result.json")):
-        try:
-            r = json.loads(f.read_text())
-        except (OSError, ValueError) as e:
-            log.warning("%s: not valid JSON (%s), ignored", f, e)
-            continue
-        problem = result_problem(r)
-        if problem:
-            log.warning("%s: %s, ignored", f, problem)
-            continue
-        if r.get("complete"):
-            r["dir"] = str(f.parent)
-            res.append(r)
-    return res
+    return [r for r in load_result_files(Path(out).glob("*/result.json")) if r.get("complete")]
 

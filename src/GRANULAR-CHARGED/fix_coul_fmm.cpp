@@ -57,7 +57,11 @@ enum : int {
 // restart format: the global list starts with this marker (older files start with the step of
 // the last evaluation, >= -1, and hold no charge checksum: they are evaluated afresh)
 static constexpr double RESTART_FORMAT_CHECKSUM = -2.0;
-enum : int { RESTART_GLOBAL_SIZE = 15 };
+// slots of the global restart list
+enum : int {
+  R_FORMAT, R_LAST, R_BOX, R_EVERY = R_BOX + 4, R_TOLERANCE, R_STRIDE, R_SLOPE, R_SUM_HI, R_SUM_LO,
+  R_QQRD2E, R_BOUNDARY, RESTART_GLOBAL_SIZE
+};
 
 // hash of one charged atom (ID, charge bits) for the checksum of the charges: summed modulo
 // 2^64 over the atoms, so the sum does not depend on their order or on the ranks holding them
@@ -82,7 +86,7 @@ static uint64_t charge_hash(tagint tag, double q)
 FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), opts(new gcfmm::Options), solver_boundary(-1), every(1), tolerance(0.0),
     stride(1), mts_estimate(-1.0), nevaluations(0), extrapolate(true), near_cutoff(0.0), last_computed(-1),
-    natoms_computed(-1), box_computed{0.0, 0.0, 0.0, 0.0}, charges_computed(0),
+    box_computed{0.0, 0.0, 0.0, 0.0}, charges_computed(0),
     qqrd2e_computed(0.0), boundary_computed(-1), bed_given(false), energy_local(0.0),
     energy_all(0.0), energy_summed(false), field(nullptr), eval_state(nullptr),
     near_delta(nullptr), nmax_ghost(0), list(nullptr), check_every(0), fresh(nullptr),
@@ -423,7 +427,6 @@ void FixCoulFMM::min_post_force(int vflag)
   v_init(vflag);
   compute_field(false);
   last_computed = update->ntimestep;
-  natoms_computed = atom->natoms;
   apply_field(vflag);
   remember_positions();
 }
@@ -496,7 +499,6 @@ void FixCoulFMM::post_force(int vflag)
   if (due) {
     compute_field(true);
     last_computed = step;
-    natoms_computed = atom->natoms;
   } else if (every > 1) {
     advance_field();
   }
@@ -1124,9 +1126,8 @@ void FixCoulFMM::unpack_forward_comm(int n, int first, double *buf_in)
 }
 
 /* ----------------------------------------------------------------------
-   restart: the step, atom count, box, charge checksum, qqrd2e and boundary of the last
-   evaluation (global), the applied and the
-   evaluated field with the evaluation positions and charges (per atom)
+   restart: the step, box, charge checksum, qqrd2e and boundary of the last evaluation
+   (global), the applied and the evaluated field with the evaluation positions and charges (per atom)
 ------------------------------------------------------------------------- */
 
 void FixCoulFMM::write_restart(FILE *fp)
@@ -1135,7 +1136,6 @@ void FixCoulFMM::write_restart(FILE *fp)
     // the 64-bit checksum as two 32-bit halves (exact in doubles)
     double list_out[RESTART_GLOBAL_SIZE] = {RESTART_FORMAT_CHECKSUM,
                                             (double) last_computed,
-                                            (double) natoms_computed,
                                             box_computed[0],
                                             box_computed[1],
                                             box_computed[2],
@@ -1158,17 +1158,16 @@ void FixCoulFMM::restart(char *buf)
 {
   auto *list_in = (double *) buf;
   // a file without the charge checksum (older format): evaluate afresh
-  if (list_in[0] != RESTART_FORMAT_CHECKSUM) return;
+  if (list_in[R_FORMAT] != RESTART_FORMAT_CHECKSUM) return;
   // a different every or tolerance gives a different schedule: evaluate afresh
-  if ((int) list_in[7] != every || list_in[8] != tolerance) return;
-  stride = (int) list_in[9];
-  slope_steps = list_in[10];
-  last_computed = (bigint) list_in[1];
-  natoms_computed = (bigint) list_in[2];
-  for (int k = 0; k < 4; k++) box_computed[k] = list_in[3 + k];
-  charges_computed = ((uint64_t) list_in[11] << 32) | (uint64_t) list_in[12];
-  qqrd2e_computed = list_in[13];
-  boundary_computed = (int) list_in[14];
+  if ((int) list_in[R_EVERY] != every || list_in[R_TOLERANCE] != tolerance) return;
+  stride = (int) list_in[R_STRIDE];
+  slope_steps = list_in[R_SLOPE];
+  last_computed = (bigint) list_in[R_LAST];
+  for (int k = 0; k < 4; k++) box_computed[k] = list_in[R_BOX + k];
+  charges_computed = ((uint64_t) list_in[R_SUM_HI] << 32) | (uint64_t) list_in[R_SUM_LO];
+  qqrd2e_computed = list_in[R_QQRD2E];
+  boundary_computed = (int) list_in[R_BOUNDARY];
 }
 
 int FixCoulFMM::pack_restart(int i, double *buf_out)

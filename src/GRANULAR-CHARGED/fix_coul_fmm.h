@@ -74,7 +74,6 @@ class FixCoulFMM : public Fix {
   bool extrapolate;          // between evaluations extrapolate the far part linearly
   double near_cutoff;        // pairs closer than this are refreshed every step (0: off)
   bigint last_computed;      // step of the last FMM evaluation (-1: none yet)
-  bigint natoms_computed;    // atom count at that evaluation (restart files; not a trigger)
   double box_computed[4];    // xlo, ylo, xprd, yprd at that evaluation
   uint64_t charges_computed;    // sum of hash(ID, q) over the charged atoms at that evaluation
   double qqrd2e_computed;       // force->qqrd2e (units, dielectric) at that evaluation

@@ -122,7 +122,8 @@ void GranSubModNormalJKRMarshall::init()
 
 bool GranSubModNormalJKRMarshall::touch()
 {
-  use_jkr_scales(scales, gm->Reff, cohesion, Emix);
+  // delta_C matters only to a contact that exists: a new one forms at delta >= 0
+  if (gm->touch) use_jkr_scales(scales, gm->Reff, cohesion, Emix);
   return jkr_touch(gm->touch, gm->rsq, gm->radsum, scales.deltac);
 }
 

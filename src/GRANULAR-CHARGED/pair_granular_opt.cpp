@@ -105,11 +105,12 @@ void PairGranularOpt::setup_fused()
     hist_twisting = model->twisting_model->history_index;
   }
   // a heat model needs PairGranular's heat-flow bookkeeping, which the fused loop does not do
-  generic_only = true;
-  for (int n = 0; n < nmodels; n++)
-    if (fused[n].on) generic_only = false;
-  for (int n = 0; n < nmodels; n++)
-    if (models_list[n]->sub_models[HEAT]->name != "none") generic_only = true;
+  bool any_fused = false, any_heat = false;
+  for (int n = 0; n < nmodels; n++) {
+    any_fused = any_fused || fused[n].on;
+    any_heat = any_heat || models_list[n]->sub_models[HEAT]->name != "none";
+  }
+  generic_only = !any_fused || any_heat;
   fused_ready = true;
 }
 
@@ -194,9 +195,9 @@ void PairGranularOpt::compute(int eflag, int vflag)
           fm.radi = radi;
           fm.radj = radj;
           fm.reff = radi * radj / radsum;
+          MK::use_jkr_scales(fm.scales, fm.reff, fm.gamma, fm.emix);
         }
         const double reff = fm.reff;
-        MK::use_jkr_scales(fm.scales, reff, fm.gamma, fm.emix);
         if (!MK::jkr_touch(touch[jj] != 0, rsq, radsum, fm.scales.deltac)) {
           touch[jj] = 0;
           for (int k = 0; k < size_hist; k++) history[k] = 0.0;

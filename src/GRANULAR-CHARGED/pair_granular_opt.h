@@ -54,7 +54,7 @@ class PairGranularOpt : public PairGranular {
     bool twisting = false;            // twisting marshall/jkr defined
     MarshallKernels::JKRScales scales;    // delta_C, a_sep, F_C of the last R_eff
     // the last pair's radii and masses: a monodisperse packing divides and takes roots once
-    double radi = -1.0, radj = -1.0, reff = 0.0;      // R_eff of radii radi, radj
+    double radi = -1.0, radj = -1.0, reff = 0.0;      // R_eff (and scales) of radii radi, radj
     double mi = -1.0, mj = -1.0, meff = 0.0;          // m* of masses mi, mj
     double sqrt_mass_of = -1.0, sqrt_mass = 0.0;      // sqrt(mass_factor m*) of m* = sqrt_mass_of
   };

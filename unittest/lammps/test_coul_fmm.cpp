@@ -447,6 +447,18 @@ std::pair<double, std::vector<double>> fresh_evaluation(Lmp &l, const std::strin
   l.cmds({"unfix " + old_fix, "fix fresh all coul/fmm accuracy 1e-6", "run 0 post no"});
   return {l.var("f_fresh"), forces_by_id(l, maxid)};
 }
+
+// energy and forces of fix fmm as they stand against a fresh fix at the same positions
+void expect_as_fresh(Lmp &l, const char *what, int maxid)
+{
+  const double e = l.var("f_fmm");
+  const auto f = forces_by_id(l, maxid);
+  const auto ref = fresh_evaluation(l, "fmm", maxid);
+  std::printf("[ stale: %s ] energy %.8g vs fresh %.8g, forces %.3g\n", what, e, ref.first,
+              rel_rms(f, ref.second));
+  EXPECT_NEAR(e, ref.first, 1e-10 * std::fabs(ref.first));
+  EXPECT_LT(rel_rms(f, ref.second), 1e-10);
+}
 }    // namespace
 
 // fix adapt changes charges during a run, between scheduled evaluations (every 10)
@@ -456,15 +468,8 @@ TEST(CoulFMM, StaleFieldChargesAdapted)
   random_charges(l, "p p f", 200, 20.0, 40.0, 17);
   l.cmds({"group odd id 1:200:2", "variable qa equal 1.0+0.2*step",
           "fix ad odd adapt 1 atom charge v_qa reset no",
-          "fix fmm all coul/fmm accuracy 1e-6 every 10", "run 3 post no"});
-  const double e = l.var("f_fmm");
-  const auto f = forces_by_id(l, 200);
-  l.cmd("unfix ad");
-  const auto ref = fresh_evaluation(l, "fmm", 200);
-  std::printf("[ stale: fix adapt ] energy %.8g vs fresh %.8g, forces %.3g\n", e, ref.first,
-              rel_rms(f, ref.second));
-  EXPECT_NEAR(e, ref.first, 1e-10 * std::fabs(ref.first));
-  EXPECT_LT(rel_rms(f, ref.second), 1e-10);
+          "fix fmm all coul/fmm accuracy 1e-6 every 10", "run 3 post no", "unfix ad"});
+  expect_as_fresh(l, "fix adapt", 200);
 }
 
 // fix deposit inserts a charge and fix evaporate removes one on the same step (step 8): the
@@ -487,14 +492,9 @@ TEST(CoulFMM, StaleFieldInsertAndDeleteSameStep)
   std::remove("coul_fmm_swap.mol");
   // deposit on steps 1 and 8, evaporate on step 8: 100 + 2 - 1
   ASSERT_EQ(l.var("count(all)"), 101.0);
-  const double e = l.var("f_fmm");
-  const auto f = forces_by_id(l, 102);    // IDs 1-100, 101 and 102 inserted, one of 1-100 gone
   l.cmds({"unfix feed", "unfix gone"});
-  const auto ref = fresh_evaluation(l, "fmm", 102);
-  std::printf("[ stale: deposit + evaporate ] energy %.8g vs fresh %.8g, forces %.3g\n", e,
-              ref.first, rel_rms(f, ref.second));
-  EXPECT_NEAR(e, ref.first, 1e-10 * std::fabs(ref.first));
-  EXPECT_LT(rel_rms(f, ref.second), 1e-10);
+  // IDs 1-100, 101 and 102 inserted, one of 1-100 gone
+  expect_as_fresh(l, "deposit + evaporate", 102);
 }
 
 // dielectric changed between runs: run 0 must report the new energy (qqrd2e changed)
@@ -523,13 +523,7 @@ TEST(CoulFMM, StaleFieldBoundaryChanged)
   random_charges(l, "f f f", 100, 20.0, 40.0, 3);
   l.cmds({"fix fmm all coul/fmm accuracy 1e-6", "run 0 post no", "change_box all boundary p p f",
           "run 0 post no"});
-  const double e = l.var("f_fmm");
-  const auto f = forces_by_id(l, 100);
-  const auto ref = fresh_evaluation(l, "fmm", 100);
-  std::printf("[ stale: change_box ] energy %.8g vs fresh %.8g, forces %.3g\n", e, ref.first,
-              rel_rms(f, ref.second));
-  EXPECT_NEAR(e, ref.first, 1e-10 * std::fabs(ref.first));
-  EXPECT_LT(rel_rms(f, ref.second), 1e-10);
+  expect_as_fresh(l, "change_box", 100);
 }
 
 // issue 28, item 5: 100 charges in a 10 A cell and one charge 1e6 A above them (H/L = 1e5):
