@@ -11,13 +11,14 @@
 // home of each formula, called by the sub-model classes (gran_sub_mod_*_marshall*.cpp, which
 // are the plumbing between LAMMPS's GranularModel and these functions) and by the fused kernel
 // of pair_style granular/opt. Same shape as the gran_sub_mod_*_kernel.h headers of LAMMPS's
-// development branch. Depends only on the header-only MathExtra and on jkr_scaled.h.
+// development branch. Depends only on the header-only MathConst and MathExtra and on jkr_scaled.h.
 // Equation numbers: doc/theory.md.
 
 #ifndef LMP_GC_MARSHALL_KERNELS_H
 #define LMP_GC_MARSHALL_KERNELS_H
 
 #include "jkr_scaled.h"
+#include "math_const.h"
 #include "math_extra.h"
 
 #include <cmath>
@@ -28,7 +29,6 @@ namespace MarshallKernels {
   // delta_C = a_0^2 / (2 6^(1/3) R) with a_0^3 = 9 pi gamma R^2 / E
   //         = DELTAC_PREFIX * (R gamma^2 / E^2)^(1/3)
   static constexpr double DELTAC_PREFIX = 2.5537664411075656;    // (9 pi)^(2/3) / (2 6^(1/3))
-  static constexpr double PI = 3.14159265358979323846;
   static constexpr double THREEPI_16 = 0.5890486225480862;    // 3 pi / 16
   // frame-rotation threshold of the tangential history, LAMMPS's EPSILON in
   // gran_sub_mod_tangential.cpp (rotating a history already in the plane changes nothing)
@@ -62,8 +62,8 @@ namespace MarshallKernels {
     sc.reff = reff;
     sc.deltac = critical_overlap(reff, gamma, emix);
     sc.inv_deltac = (sc.deltac > 0.0) ? 1.0 / sc.deltac : 0.0;
-    sc.asep = cbrt(PI * gamma * reff * reff / (4.0 * emix));
-    sc.fc = 3.0 * PI * gamma * reff;
+    sc.asep = cbrt(MathConst::MY_PI * gamma * reff * reff / (4.0 * emix));
+    sc.fc = 3.0 * MathConst::MY_PI * gamma * reff;
     sc.sqrt_kn_sep = sqrt(4.0 / 3.0 * emix * sc.asep);
   }
 
