@@ -476,11 +476,14 @@ TEST(JKRMarshall, MixingUnlikeTypes)
 }
 
 // 8. bad input: each refused with a message naming the model and the value
-TEST(JKRMarshall, BadInput)
+// the same messages from pair_style granular and granular/opt (which parses through granular)
+class BadInput : public ::testing::TestWithParam<const char *> {};
+
+TEST_P(BadInput, NamesTheStyleAndTheValue)
 {
   const std::vector<std::string> base = {
       "units si", "atom_style sphere", "region box block 0 1e-5 0 1e-5 0 1e-5",
-      "create_box 1 box", "pair_style granular"};
+      "create_box 1 box", std::string("pair_style ") + GetParam()};
   auto err = [&](const std::string &coeff) {
     auto c = base;
     c.push_back("pair_coeff * * " + coeff);
@@ -520,3 +523,5 @@ TEST(JKRMarshall, BadInput)
                    "1e3 1.0 0.3 twisting marshall/jkr"),
                "Twisting marshall/jkr requires tangential model marshall or mindlin.*linear_history");
 }
+
+INSTANTIATE_TEST_SUITE_P(JKRMarshall, BadInput, ::testing::Values("granular", "granular/opt"));
