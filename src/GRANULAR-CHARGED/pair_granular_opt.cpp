@@ -9,6 +9,8 @@
 
 #include "pair_granular_opt.h"
 
+#include "fix_sleep_gran.h"
+
 #include "gran_sub_mod_damping_marshall.h"
 #include "gran_sub_mod_normal_jkr_marshall.h"
 #include "gran_sub_mod_rolling_marshall.h"
@@ -17,6 +19,7 @@
 
 #include "atom.h"
 #include "comm.h"
+#include "error.h"
 #include "fix.h"
 #include "fix_neigh_history.h"
 #include "force.h"
@@ -24,6 +27,7 @@
 #include "granular_model.h"
 #include "math_extra.h"
 #include "memory.h"
+#include "modify.h"
 #include "neigh_list.h"
 #include "neighbor.h"
 #include "update.h"
@@ -39,7 +43,8 @@ namespace MK = MarshallKernels;
 /* ---------------------------------------------------------------------- */
 
 PairGranularOpt::PairGranularOpt(LAMMPS *lmp) :
-    PairGranular(lmp), fused_ready(false), generic_only(true), hist_tangential(0), hist_rolling(0), hist_twisting(0)
+    PairGranular(lmp), fused_ready(false), generic_only(true), any_heat(false), sleep_fix(nullptr),
+    active_build(-1), active_generation(-1), hist_tangential(0), hist_rolling(0), hist_twisting(0)
 {
 }
 
@@ -49,6 +54,10 @@ void PairGranularOpt::init_style()
 {
   PairGranular::init_style();
   fused_ready = false;    // init_one() may still mix new models: set up before the first compute
+  auto sleepers = modify->get_fix_by_style("^sleep/gran$");
+  sleep_fix = sleepers.empty() ? nullptr : dynamic_cast<FixSleepGran *>(sleepers.front());
+  if (sleepers.size() > 1) error->all(FLERR, "Only one fix sleep/gran may be defined");
+  active_build = active_generation = -1;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -105,7 +114,8 @@ void PairGranularOpt::setup_fused()
     hist_twisting = model->twisting_model->history_index;
   }
   // a heat model needs PairGranular's heat-flow bookkeeping, which the fused loop does not do
-  bool any_fused = false, any_heat = false;
+  bool any_fused = false;
+  any_heat = false;
   for (int n = 0; n < nmodels; n++) {
     any_fused = any_fused || fused[n].on;
     any_heat = any_heat || models_list[n]->sub_models[HEAT]->name != "none";
@@ -127,7 +137,9 @@ void PairGranularOpt::compute(int eflag, int vflag)
 {
   if (!fused_ready) setup_fused();
 
-  if (generic_only || fix_rigid) {
+  if (sleep_fix && (any_heat || fix_rigid))
+    error->all(FLERR, "Fix sleep/gran cannot be used with a heat model or rigid bodies");
+  if (!sleep_fix && (generic_only || fix_rigid)) {
     // nothing to fuse, a heat model, or rigid-body masses: the sub-model path does it all
     PairGranular::compute(eflag, vflag);
     return;
@@ -159,7 +171,15 @@ void PairGranularOpt::compute(int eflag, int vflag)
   int **firsttouch = use_history ? fix_history->firstflag : nullptr;
   double **firsthistory = use_history ? fix_history->firstvalue : nullptr;
 
-  for (int ii = 0; ii < inum; ii++) {
+  // sleepers: pairs of two sleepers are skipped (history kept); the sleeper's share of a pair
+  // with an awake atom is also summed into the fix's push array (its wake test)
+  const double *asleep = sleep_fix ? sleep_fix->sleeping() : nullptr;
+  double **push = sleep_fix ? sleep_fix->awake_push() : nullptr;
+  if (asleep) update_active(asleep);
+  const int nactive = asleep ? static_cast<int>(active.size()) : inum;
+
+  for (int aa = 0; aa < nactive; aa++) {
+    const int ii = asleep ? active[aa] : aa;
     const int i = ilist[ii];
     const int itype = type[i];
     int *touch = use_history ? firsttouch[i] : nullptr;
@@ -172,6 +192,7 @@ void PairGranularOpt::compute(int eflag, int vflag)
       const double factor_lj = special_lj[sbmask(j)];
       j &= NEIGHMASK;
       if (factor_lj == 0) continue;
+      if (asleep && asleep[i] != 0.0 && asleep[j] != 0.0) continue;
 
       const int jtype = type[j];
       const int imodel = types_indices[itype][jtype];
@@ -334,6 +355,61 @@ void PairGranularOpt::compute(int eflag, int vflag)
       if (evflag)
         ev_tally_xyz(i, j, nlocal, newton_pair, 0.0, 0.0, forces[0], forces[1], forces[2], dx[0],
                      dx[1], dx[2]);
+      if (asleep) {
+        if (asleep[i] != 0.0) add3(push[i], forces, push[i]);
+        if (asleep[j] != 0.0 && (newton_pair || j < nlocal)) sub3(push[j], forces, push[j]);
+      }
+    }
+  }
+}
+
+/* ----------------------------------------------------------------------
+   the list entries that can hold a computed pair: an awake atom, or a sleeper with an awake
+   neighbor
+------------------------------------------------------------------------- */
+
+void PairGranularOpt::update_active(const double *asleep)
+{
+  if (active_build == neighbor->lastcall && active_generation == sleep_fix->generation()) return;
+  active_build = neighbor->lastcall;
+  active_generation = sleep_fix->generation();
+  active.clear();
+  const int inum = list->inum;
+  for (int ii = 0; ii < inum; ii++) {
+    const int i = list->ilist[ii];
+    bool keep = asleep[i] == 0.0;
+    const int *jlist = list->firstneigh[i];
+    for (int jj = 0; !keep && jj < list->numneigh[i]; jj++) keep = asleep[jlist[jj] & NEIGHMASK] == 0.0;
+    if (keep) active.push_back(ii);
+  }
+}
+
+/* ---------------------------------------------------------------------- */
+
+void PairGranularOpt::mark_touching_sleepers(const double *flag, double *mark) const
+{
+  double **x = atom->x;
+  double *radius = atom->radius;
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    const int *jlist = list->firstneigh[i];
+    const int *touch = use_history ? fix_history->firstflag[i] : nullptr;
+    for (int jj = 0; jj < list->numneigh[i]; jj++) {
+      const int j = jlist[jj] & NEIGHMASK;
+      const bool pushed_sleeper = (flag[i] < 0.0 && flag[j] > 0.0) || (flag[j] < 0.0 && flag[i] > 0.0);
+      if (!pushed_sleeper) continue;
+      bool touching;
+      if (touch) {
+        touching = touch[jj] != 0;
+      } else {
+        double dx[3];
+        sub3(x[i], x[j], dx);
+        const double radsum = radius[i] + radius[j];
+        touching = lensq3(dx) < radsum * radsum;
+      }
+      if (!touching) continue;
+      if (flag[i] > 0.0) mark[i] = 1.0;
+      if (flag[j] > 0.0) mark[j] = 1.0;
     }
   }
 }

@@ -38,6 +38,10 @@ class PairGranularOpt : public PairGranular {
   // for tests and the log: does model n run the fused kernel?
   bool model_is_fused(int n) const;
 
+  // fix sleep/gran: set mark[j] = 1 for every sleeper j (flag 1) touching an atom flagged -1
+  // (local and ghost atoms of this rank's list)
+  void mark_touching_sleepers(const double *flag, double *mark) const;
+
  protected:
   // coefficients of one model for the fused kernel, copied from its sub-models
   struct FusedMarshall {
@@ -61,9 +65,16 @@ class PairGranularOpt : public PairGranular {
   std::vector<FusedMarshall> fused;      // one per entry of models_list
   bool fused_ready;                      // false after init_style(): rebuild before compute()
   bool generic_only;                     // no model fused (or a heat model): PairGranular's path
+  bool any_heat;                         // a model with heat conduction
+  class FixSleepGran *sleep_fix;         // fix sleep/gran, if defined
+  // with sleepers: the list entries ii whose atom is awake or has an awake neighbor, rebuilt
+  // after each neighbor list build and each change of the sleeping set
+  std::vector<int> active;
+  bigint active_build, active_generation;
   int hist_tangential, hist_rolling, hist_twisting;    // offsets in the per-pair history
 
   void setup_fused();
+  void update_active(const double *asleep);
 };
 
 }    // namespace LAMMPS_NS

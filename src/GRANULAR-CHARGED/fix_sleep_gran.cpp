@@ -1,0 +1,552 @@
+/* ----------------------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+#include "fix_sleep_gran.h"
+
+#include "pair_granular_opt.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "domain.h"
+#include "error.h"
+#include "force.h"
+#include "group.h"
+#include "memory.h"
+#include "modify.h"
+#include "neighbor.h"
+#include "update.h"
+
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+using namespace LAMMPS_NS;
+using namespace FixConst;
+
+namespace {
+// what pack_forward_comm() and pack_reverse_comm() move
+enum CommMode { COMM_FLAGS, COMM_PUSH, COMM_WAKE };
+// slots of the global restart list
+enum RestartSlot { R_SLEEP_EVENTS, R_WAKE_EVENTS, R_NSLOTS };
+}    // namespace
+
+/* ---------------------------------------------------------------------- */
+
+FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
+    Fix(lmp, narg, arg), speed_sleep(-1.0), force_sleep(-1.0), force_wake(-1.0), rest_time(-1.0),
+    depth(0.0), depth_bin(0.0), every(100), rest_steps_needed(0), asleep(nullptr),
+    rest_steps(nullptr), push(nullptr), wake_mark(nullptr), comm_mode(COMM_FLAGS),
+    set_generation(0), nsleeping_all(0), nsleep_events(0), nwake_events(0), pair_checked(0)
+{
+  if (!(atom->radius_flag && atom->rmass_flag && atom->omega_flag && atom->torque_flag))
+    error->all(FLERR, "Fix {} requires atom attributes radius, rmass, omega and torque (atom_style sphere)", style);
+
+  int iarg = 3;
+  auto positive = [&](const char *key) {
+    if (iarg + 2 > narg) utils::missing_cmd_args(FLERR, std::string("fix sleep/gran ") + key, error);
+    const double v = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
+    if (!(v > 0.0) || !std::isfinite(v))
+      error->all(FLERR, "Fix {} {} must be > 0, got {}", style, key, arg[iarg + 1]);
+    iarg += 2;
+    return v;
+  };
+  while (iarg < narg) {
+    if (strcmp(arg[iarg], "speed") == 0) {
+      speed_sleep = positive("speed");
+    } else if (strcmp(arg[iarg], "force") == 0) {
+      force_sleep = positive("force");
+    } else if (strcmp(arg[iarg], "wake") == 0) {
+      force_wake = positive("wake");
+    } else if (strcmp(arg[iarg], "time") == 0) {
+      if (iarg + 2 > narg) utils::missing_cmd_args(FLERR, "fix sleep/gran time", error);
+      rest_time = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
+      if (!(rest_time >= 0.0) || !std::isfinite(rest_time))
+        error->all(FLERR, "Fix {} time must be >= 0, got {}", style, arg[iarg + 1]);
+      iarg += 2;
+    } else if (strcmp(arg[iarg], "every") == 0) {
+      if (iarg + 2 > narg) utils::missing_cmd_args(FLERR, "fix sleep/gran every", error);
+      every = utils::inumeric(FLERR, arg[iarg + 1], false, lmp);
+      if (every < 1) error->all(FLERR, "Fix {} every must be >= 1, got {}", style, arg[iarg + 1]);
+      iarg += 2;
+    } else if (strcmp(arg[iarg], "depth") == 0) {
+      depth = positive("depth");
+    } else {
+      error->all(FLERR, "Unknown fix {} keyword {}", style, arg[iarg]);
+    }
+  }
+  if (speed_sleep < 0.0 || force_sleep < 0.0 || force_wake < 0.0 || rest_time < 0.0)
+    error->all(FLERR, "Fix {} needs the keywords speed, force, wake and time", style);
+  // the wake threshold below the sleep threshold would wake what just fell asleep
+  if (force_wake < force_sleep)
+    error->all(FLERR, "Fix {} wake ({}) must be >= force ({})", style, force_wake, force_sleep);
+  depth_bin = depth;    // columns of side depth
+
+  scalar_flag = 1;
+  vector_flag = 1;
+  size_vector = 4;
+  global_freq = 1;
+  extscalar = 0;
+  extvector = 0;
+  peratom_flag = 1;
+  size_peratom_cols = 0;
+  peratom_freq = 1;
+  create_attribute = 1;    // created atoms are awake (set_arrays)
+  restart_peratom = 1;
+  restart_global = 1;
+  comm_forward = 1;
+  comm_reverse = 3;
+
+  FixSleepGran::grow_arrays(atom->nmax);
+  atom->add_callback(Atom::GROW);
+  atom->add_callback(Atom::RESTART);
+  for (int i = 0; i < atom->nmax; i++) {
+    asleep[i] = rest_steps[i] = wake_mark[i] = 0.0;
+    push[i][0] = push[i][1] = push[i][2] = 0.0;
+  }
+}
+
+/* ---------------------------------------------------------------------- */
+
+FixSleepGran::~FixSleepGran()
+{
+  if (copymode) return;
+  atom->delete_callback(id, Atom::GROW);
+  atom->delete_callback(id, Atom::RESTART);
+  memory->destroy(asleep);
+  memory->destroy(rest_steps);
+  memory->destroy(push);
+  memory->destroy(wake_mark);
+}
+
+/* ---------------------------------------------------------------------- */
+
+int FixSleepGran::setmask()
+{
+  return PRE_FORCE | POST_FORCE;
+}
+
+/* ---------------------------------------------------------------------- */
+
+void FixSleepGran::init()
+{
+  if (!force->pair_match("^granular/opt", 0))
+    error->all(FLERR,
+               "Fix {} requires pair_style granular/opt (the same physics as granular: use "
+               "-sf opt or 'pair_style granular/opt'), not {}",
+               style, force->pair_style ? force->pair_style : "none");
+  for (auto *f : modify->get_fix_list()) {
+    if (f->rigid_flag) error->all(FLERR, "Fix {} cannot be used with the rigid-body fix {}", style, f->id);
+    if (utils::strmatch(f->style, "^deposit") || utils::strmatch(f->style, "^pour"))
+      if (groupbit != 1 && f->groupbit != groupbit)
+        error->all(FLERR,
+                   "Fix {} group {} does not contain the atoms that fix {} {} inserts (group {}): "
+                   "use group all or the same group",
+                   style, group->names[igroup], f->style, f->id, group->names[f->igroup]);
+  }
+  if (update->whichflag == 2) error->all(FLERR, "Fix {} cannot be used with minimization", style);
+  check_fix_order();
+  rest_steps_needed = static_cast<int>(std::ceil(rest_time / update->dt - 1e-9));
+}
+
+/* ----------------------------------------------------------------------
+   the forces tested and zeroed in post_force() must be complete: no fix that adds forces in
+   post_force may come after this one
+------------------------------------------------------------------------- */
+
+void FixSleepGran::check_fix_order()
+{
+  bool after = false;
+  for (auto *f : modify->get_fix_list()) {
+    if (f == this) {
+      after = true;
+      continue;
+    }
+    if (after && (f->setmask() & POST_FORCE))
+      error->all(FLERR,
+                 "Fix {} must be defined after every fix that adds forces; fix {} ({}) comes "
+                 "after it",
+                 style, f->id, f->style);
+  }
+}
+
+/* ---------------------------------------------------------------------- */
+
+void FixSleepGran::setup_pre_force(int /*vflag*/)
+{
+  exchange_flags();
+  const int nall = atom->nlocal + atom->nghost;
+  for (int i = 0; i < nall; i++) push[i][0] = push[i][1] = push[i][2] = 0.0;
+}
+
+/* ---------------------------------------------------------------------- */
+
+void FixSleepGran::setup(int /*vflag*/)
+{
+  count_sleeping();
+  hold_sleepers();
+}
+
+/* ----------------------------------------------------------------------
+   ghosts are new after a neighbor list build: give them their owners' flags
+------------------------------------------------------------------------- */
+
+void FixSleepGran::pre_force(int /*vflag*/)
+{
+  if (neighbor->ago == 0) exchange_flags();
+  const int nall = atom->nlocal + atom->nghost;
+  for (int i = 0; i < nall; i++) push[i][0] = push[i][1] = push[i][2] = 0.0;
+}
+
+/* ---------------------------------------------------------------------- */
+
+void FixSleepGran::exchange_flags()
+{
+  comm_mode = COMM_FLAGS;
+  comm->forward_comm(this);
+}
+
+/* ---------------------------------------------------------------------- */
+
+void FixSleepGran::post_force(int /*vflag*/)
+{
+  if (force->newton_pair) {
+    comm_mode = COMM_PUSH;
+    comm->reverse_comm(this, 3);
+  }
+  const int nlocal = atom->nlocal;
+  int changed = 0;
+
+  wake_pushed();
+
+  // rest time of the awake atoms of the group
+  int *mask = atom->mask;
+  for (int i = 0; i < nlocal; i++) {
+    if (asleep[i] != 0.0) continue;
+    if ((mask[i] & groupbit) && at_rest(i))
+      rest_steps[i] += 1.0;
+    else
+      rest_steps[i] = 0.0;
+  }
+
+  const bigint before = nsleep_events;
+  if (update->ntimestep % every == 0) fall_asleep();
+  changed = nsleep_events != before;
+  int any = 0;
+  MPI_Allreduce(&changed, &any, 1, MPI_INT, MPI_MAX, world);
+  if (any) {
+    exchange_flags();
+    set_generation++;
+    count_sleeping();
+  }
+  hold_sleepers();
+}
+
+/* ---------------------------------------------------------------------- */
+
+bool FixSleepGran::at_rest(int i) const
+{
+  const double *v = atom->v[i], *w = atom->omega[i], *f = atom->f[i];
+  const double r = atom->radius[i];
+  const double vs2 = speed_sleep * speed_sleep;
+  if (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] >= vs2) return false;
+  if ((w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * r * r >= vs2) return false;
+  return f[0] * f[0] + f[1] * f[1] + f[2] * f[2] < force_sleep * force_sleep;
+}
+
+/* ----------------------------------------------------------------------
+   a sleeper whose awake contact partners push it with more than `wake` wakes, and so do the
+   sleepers touching it (through the pair style's list and contact flags; sleepers owned by
+   another rank get the request by reverse communication)
+------------------------------------------------------------------------- */
+
+void FixSleepGran::wake_pushed()
+{
+  const int nlocal = atom->nlocal;
+  const int nall = nlocal + atom->nghost;
+  const double fw2 = force_wake * force_wake;
+  int woken = 0;
+  for (int i = 0; i < nall; i++) wake_mark[i] = 0.0;
+  for (int i = 0; i < nlocal; i++) {
+    if (asleep[i] == 0.0) continue;
+    const double *p = push[i];
+    if (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] > fw2) {
+      wake_mark[i] = 1.0;
+      woken++;
+    }
+  }
+  int any = 0;
+  MPI_Allreduce(&woken, &any, 1, MPI_INT, MPI_MAX, world);
+  if (!any) return;
+
+  // the pushed atoms are flagged -1 for one exchange, so that the pair style can mark the
+  // sleepers (1) touching them, local or ghost; ghost marks go to their owners
+  for (int i = 0; i < nlocal; i++)
+    if (wake_mark[i] != 0.0) asleep[i] = -1.0;
+  exchange_flags();
+  auto *pair = dynamic_cast<PairGranularOpt *>(force->pair_match("^granular/opt", 0));
+  if (pair) pair->mark_touching_sleepers(asleep, wake_mark);
+  comm_mode = COMM_WAKE;
+  comm->reverse_comm(this, 1);
+
+  int nwoken = 0;
+  for (int i = 0; i < nlocal; i++) {
+    if (wake_mark[i] == 0.0) continue;
+    asleep[i] = 0.0;
+    rest_steps[i] = 0.0;
+    nwoken++;
+  }
+  bigint nw = nwoken, all = 0;
+  MPI_Allreduce(&nw, &all, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+  nwake_events += all;
+  exchange_flags();
+  set_generation++;
+  count_sleeping();
+}
+
+/* ----------------------------------------------------------------------
+   commit to sleep the atoms at rest for the rest time, and (keyword depth) those slower than
+   10 x speed lying at least `depth` below the top of the bed in their column
+------------------------------------------------------------------------- */
+
+void FixSleepGran::fall_asleep()
+{
+  const int nlocal = atom->nlocal;
+  int *mask = atom->mask;
+  double **x = atom->x;
+
+  std::vector<double> top;
+  int nbx = 0, nby = 0;
+  if (depth > 0.0) surface_heights(top, nbx, nby);
+
+  double **v = atom->v;
+  const double vdeep2 = 100.0 * speed_sleep * speed_sleep;
+  bigint n = 0;
+  for (int i = 0; i < nlocal; i++) {
+    if (asleep[i] != 0.0 || !(mask[i] & groupbit)) continue;
+    bool sleep = rest_steps[i] >= rest_steps_needed && rest_steps[i] >= 1.0;
+    if (!sleep && depth > 0.0 && v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2] < vdeep2) {
+      int bx = static_cast<int>((x[i][0] - domain->boxlo[0]) / domain->xprd * nbx);
+      int by = static_cast<int>((x[i][1] - domain->boxlo[1]) / domain->yprd * nby);
+      bx = MIN(MAX(bx, 0), nbx - 1);
+      by = MIN(MAX(by, 0), nby - 1);
+      sleep = top[by * nbx + bx] - x[i][2] >= depth;
+    }
+    if (!sleep) continue;
+    asleep[i] = 1.0;
+    n++;
+  }
+  bigint all = 0;
+  MPI_Allreduce(&n, &all, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+  nsleep_events += all;
+}
+
+/* ----------------------------------------------------------------------
+   highest top (z + radius) of the bed per column of side `depth` in x, y
+------------------------------------------------------------------------- */
+
+void FixSleepGran::surface_heights(std::vector<double> &top, int &nbx, int &nby) const
+{
+  nbx = MAX(1, static_cast<int>(domain->xprd / depth_bin));
+  nby = MAX(1, static_cast<int>(domain->yprd / depth_bin));
+  std::vector<double> mine(static_cast<size_t>(nbx) * nby, -1.0e300);
+  top.assign(mine.size(), -1.0e300);
+  double **x = atom->x, **v = atom->v;
+  const double vbed2 = 100.0 * speed_sleep * speed_sleep;
+  for (int i = 0; i < atom->nlocal; i++) {
+    // the bed: sleepers and atoms slower than 10 x speed (not those falling onto it)
+    if (asleep[i] == 0.0 && v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2] >= vbed2) continue;
+    int bx = static_cast<int>((x[i][0] - domain->boxlo[0]) / domain->xprd * nbx);
+    int by = static_cast<int>((x[i][1] - domain->boxlo[1]) / domain->yprd * nby);
+    bx = MIN(MAX(bx, 0), nbx - 1);
+    by = MIN(MAX(by, 0), nby - 1);
+    double &t = mine[by * nbx + bx];
+    t = MAX(t, x[i][2] + atom->radius[i]);
+  }
+  MPI_Allreduce(mine.data(), top.data(), (int) mine.size(), MPI_DOUBLE, MPI_MAX, world);
+}
+
+/* ----------------------------------------------------------------------
+   a sleeper stays where it is: the integrator sees zero velocity, spin, force and torque
+------------------------------------------------------------------------- */
+
+void FixSleepGran::hold_sleepers()
+{
+  double **v = atom->v, **w = atom->omega, **f = atom->f, **t = atom->torque;
+  for (int i = 0; i < atom->nlocal; i++) {
+    if (asleep[i] == 0.0) continue;
+    v[i][0] = v[i][1] = v[i][2] = 0.0;
+    w[i][0] = w[i][1] = w[i][2] = 0.0;
+    f[i][0] = f[i][1] = f[i][2] = 0.0;
+    t[i][0] = t[i][1] = t[i][2] = 0.0;
+  }
+}
+
+/* ---------------------------------------------------------------------- */
+
+void FixSleepGran::count_sleeping()
+{
+  bigint n = 0;
+  for (int i = 0; i < atom->nlocal; i++)
+    if (asleep[i] != 0.0) n++;
+  MPI_Allreduce(&n, &nsleeping_all, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+}
+
+/* ---------------------------------------------------------------------- */
+
+double FixSleepGran::compute_scalar()
+{
+  return static_cast<double>(atom->natoms - nsleeping_all);
+}
+
+/* ----------------------------------------------------------------------
+   1 awake atoms, 2 sleeping atoms, 3 atoms fallen asleep, 4 atoms woken (3, 4 since the fix
+   was defined, kept across restarts)
+------------------------------------------------------------------------- */
+
+double FixSleepGran::compute_vector(int n)
+{
+  if (n == 0) return static_cast<double>(atom->natoms - nsleeping_all);
+  if (n == 1) return static_cast<double>(nsleeping_all);
+  if (n == 2) return static_cast<double>(nsleep_events);
+  return static_cast<double>(nwake_events);
+}
+
+/* ---------------------------------------------------------------------- */
+
+double FixSleepGran::memory_usage()
+{
+  return static_cast<double>(atom->nmax) * 6 * sizeof(double);
+}
+
+/* ---------------------------------------------------------------------- */
+
+void FixSleepGran::grow_arrays(int nmax)
+{
+  memory->grow(asleep, nmax, "sleep/gran:asleep");
+  memory->grow(rest_steps, nmax, "sleep/gran:rest_steps");
+  memory->grow(push, nmax, 3, "sleep/gran:push");
+  memory->grow(wake_mark, nmax, "sleep/gran:wake_mark");
+  vector_atom = asleep;
+}
+
+void FixSleepGran::copy_arrays(int i, int j, int /*delflag*/)
+{
+  asleep[j] = asleep[i];
+  rest_steps[j] = rest_steps[i];
+}
+
+void FixSleepGran::set_arrays(int i)
+{
+  asleep[i] = rest_steps[i] = 0.0;
+}
+
+int FixSleepGran::pack_exchange(int i, double *buf)
+{
+  buf[0] = asleep[i];
+  buf[1] = rest_steps[i];
+  return 2;
+}
+
+int FixSleepGran::unpack_exchange(int nlocal, double *buf)
+{
+  asleep[nlocal] = buf[0];
+  rest_steps[nlocal] = buf[1];
+  return 2;
+}
+
+/* ---------------------------------------------------------------------- */
+
+int FixSleepGran::pack_forward_comm(int n, int *list, double *buf, int /*pbc_flag*/, int * /*pbc*/)
+{
+  for (int k = 0; k < n; k++) buf[k] = asleep[list[k]];
+  return n;
+}
+
+void FixSleepGran::unpack_forward_comm(int n, int first, double *buf)
+{
+  for (int k = 0; k < n; k++) asleep[first + k] = buf[k];
+}
+
+int FixSleepGran::pack_reverse_comm(int n, int first, double *buf)
+{
+  int m = 0;
+  for (int i = first; i < first + n; i++) {
+    if (comm_mode == COMM_PUSH) {
+      buf[m++] = push[i][0];
+      buf[m++] = push[i][1];
+      buf[m++] = push[i][2];
+    } else {
+      buf[m++] = wake_mark[i];
+    }
+  }
+  return m;
+}
+
+void FixSleepGran::unpack_reverse_comm(int n, int *list, double *buf)
+{
+  int m = 0;
+  for (int k = 0; k < n; k++) {
+    const int j = list[k];
+    if (comm_mode == COMM_PUSH) {
+      push[j][0] += buf[m++];
+      push[j][1] += buf[m++];
+      push[j][2] += buf[m++];
+    } else {
+      wake_mark[j] = MAX(wake_mark[j], buf[m++]);
+    }
+  }
+}
+
+/* ---------------------------------------------------------------------- */
+
+void FixSleepGran::write_restart(FILE *fp)
+{
+  if (comm->me != 0) return;
+  double list[R_NSLOTS];
+  list[R_SLEEP_EVENTS] = static_cast<double>(nsleep_events);
+  list[R_WAKE_EVENTS] = static_cast<double>(nwake_events);
+  int size = R_NSLOTS * sizeof(double);
+  fwrite(&size, sizeof(int), 1, fp);
+  fwrite(list, sizeof(double), R_NSLOTS, fp);
+}
+
+void FixSleepGran::restart(char *buf)
+{
+  auto *list = reinterpret_cast<double *>(buf);
+  nsleep_events = static_cast<bigint>(list[R_SLEEP_EVENTS]);
+  nwake_events = static_cast<bigint>(list[R_WAKE_EVENTS]);
+}
+
+int FixSleepGran::pack_restart(int i, double *buf)
+{
+  buf[0] = 3;    // values of this fix, the count included
+  buf[1] = asleep[i];
+  buf[2] = rest_steps[i];
+  return 3;
+}
+
+void FixSleepGran::unpack_restart(int nlocal, int nth)
+{
+  double **extra = atom->extra;
+  int m = 0;
+  for (int k = 0; k < nth; k++) m += static_cast<int>(extra[nlocal][m]);
+  m++;
+  asleep[nlocal] = extra[nlocal][m++];
+  rest_steps[nlocal] = extra[nlocal][m++];
+}
+
+int FixSleepGran::size_restart(int /*nlocal*/)
+{
+  return 3;
+}
+
+int FixSleepGran::maxsize_restart()
+{
+  return 3;
+}
