@@ -82,9 +82,6 @@ FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
   }
   if (speed_sleep < 0.0 || force_sleep < 0.0 || force_wake < 0.0 || rest_time < 0.0)
     error->all(FLERR, "Fix {} needs the keywords speed, force, wake and time", style);
-  // the wake threshold below the sleep threshold would wake what just fell asleep
-  if (force_wake < force_sleep)
-    error->all(FLERR, "Fix {} wake ({}) must be >= force ({})", style, force_wake, force_sleep);
   depth_bin = depth;    // columns of side depth
 
   scalar_flag = 1;
@@ -224,10 +221,10 @@ void FixSleepGran::post_force(int /*vflag*/)
 
   wake_pushed();
 
-  // rest time of the awake atoms of the group
+  // rest time of the awake atoms of the group (those woken now start counting next step)
   int *mask = atom->mask;
   for (int i = 0; i < nlocal; i++) {
-    if (asleep[i] != 0.0) continue;
+    if (asleep[i] != 0.0 || wake_mark[i] != 0.0) continue;
     if ((mask[i] & groupbit) && at_rest(i))
       rest_steps[i] += 1.0;
     else
@@ -271,7 +268,7 @@ void FixSleepGran::wake_pushed()
   const int nall = nlocal + atom->nghost;
   const double fw2 = force_wake * force_wake;
   int woken = 0;
-  for (int i = 0; i < nall; i++) wake_mark[i] = 0.0;
+  for (int i = 0; i < nall; i++) wake_mark[i] = 0.0;    // also read by post_force()
   for (int i = 0; i < nlocal; i++) {
     if (asleep[i] == 0.0) continue;
     const double *p = push[i];

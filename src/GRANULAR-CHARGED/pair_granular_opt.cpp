@@ -44,7 +44,7 @@ namespace MK = MarshallKernels;
 
 PairGranularOpt::PairGranularOpt(LAMMPS *lmp) :
     PairGranular(lmp), fused_ready(false), generic_only(true), any_heat(false), sleep_fix(nullptr),
-    active_build(-1), active_generation(-1), hist_tangential(0), hist_rolling(0), hist_twisting(0)
+    active_build(-1), active_generation(-1), ncontacts(0), hist_tangential(0), hist_rolling(0), hist_twisting(0)
 {
 }
 
@@ -177,6 +177,7 @@ void PairGranularOpt::compute(int eflag, int vflag)
   double **push = sleep_fix ? sleep_fix->awake_push() : nullptr;
   if (asleep) update_active(asleep);
   const int nactive = asleep ? static_cast<int>(active.size()) : inum;
+  bigint contacts = 0;
 
   for (int aa = 0; aa < nactive; aa++) {
     const int ii = asleep ? active[aa] : aa;
@@ -236,6 +237,7 @@ void PairGranularOpt::compute(int eflag, int vflag)
         double meff = fm.meff;
         if (mask[i] & freeze_group_bit) meff = mj;
         if (mask[j] & freeze_group_bit) meff = mi;
+        if (asleep) sleeper_mass(asleep[i], asleep[j], mi, mj, meff);
         if (meff != fm.sqrt_mass_of) {
           fm.sqrt_mass_of = meff;
           fm.sqrt_mass = MK::damping_sqrt_mass(fm.mass_factor, meff);
@@ -329,6 +331,7 @@ void PairGranularOpt::compute(int eflag, int vflag)
         double meff = mi * mj / (mi + mj);
         if (mask[i] & freeze_group_bit) meff = mj;
         if (mask[j] & freeze_group_bit) meff = mi;
+        if (asleep) sleeper_mass(asleep[i], asleep[j], mi, mj, meff);
         model->meff = meff;
         model->vi = v[i];
         model->vj = v[j];
@@ -343,6 +346,7 @@ void PairGranularOpt::compute(int eflag, int vflag)
       }
 
       // apply forces & torques
+      contacts++;
       scale3(factor_lj, forces);
       add3(f[i], forces, f[i]);
       scale3(factor_lj, torquesi);
@@ -361,6 +365,7 @@ void PairGranularOpt::compute(int eflag, int vflag)
       }
     }
   }
+  ncontacts = contacts;
 }
 
 /* ----------------------------------------------------------------------

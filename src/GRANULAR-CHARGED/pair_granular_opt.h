@@ -41,6 +41,8 @@ class PairGranularOpt : public PairGranular {
   // fix sleep/gran: set mark[j] = 1 for every sleeper j (flag 1) touching an atom flagged -1
   // (local and ghost atoms of this rank's list)
   void mark_touching_sleepers(const double *flag, double *mark) const;
+  // contacts (touching pairs) whose forces the last compute() evaluated in its own loop
+  bigint contacts_computed() const { return ncontacts; }
 
  protected:
   // coefficients of one model for the fused kernel, copied from its sub-models
@@ -71,9 +73,16 @@ class PairGranularOpt : public PairGranular {
   // after each neighbor list build and each change of the sleeping set
   std::vector<int> active;
   bigint active_build, active_generation;
+  bigint ncontacts;
   int hist_tangential, hist_rolling, hist_twisting;    // offsets in the per-pair history
 
   void setup_fused();
+  // a sleeper is a fixed body, as an atom of fix freeze: the effective mass is the other's
+  static void sleeper_mass(double sleep_i, double sleep_j, double mi, double mj, double &meff)
+  {
+    if (sleep_i != 0.0) meff = mj;
+    if (sleep_j != 0.0) meff = mi;
+  }
   void update_active(const double *asleep);
 };
 

@@ -1,0 +1,262 @@
+/* GRANULAR-CHARGED: fix sleep/gran with pair_style granular/opt.
+
+   - Held and skipped: a bed whose atoms all sleep does not move by one bit, its contacts are
+     not computed (the pair style's count of evaluated contacts is 0; it is > 0 without the fix)
+     and their history is kept (the pair forces of compute pair/local, which recomputes them
+     from the history, do not change).
+   - Fixed body: an awake sphere hitting a sleeper follows, bit for bit, the trajectory it has
+     when the other sphere is held by fix freeze at zero velocity: the sleeper is a fixed body
+     of its own shape with the contact law of LAMMPS's frozen atoms (m* = the awake atom's mass).
+   - Waking: a sleeper pushed beyond `wake` wakes, and so does the sleeper touching it; with the
+     wake threshold above the push nothing wakes.
+   - Restart and migration: the flags survive write_restart/read_restart and atoms moving to
+     another rank (displace_atoms by half the box: on 2 ranks every atom changes rank).
+   - Bad input: every refused keyword value, a pair style other than granular/opt, a point
+     particle atom style, a fix that adds forces after it, an injection into another group.
+
+   Checked against broken code: without the skip in the pair loop HeldAndSkipped fails (contacts
+   > 0); without zeroing the velocities of sleepers it fails (the bed moves); with the sleeper's
+   push summed with the wrong sign or not at all, WakesWhenPushed fails; without pack_exchange
+   of the flags the two-rank migration fails; without pack_restart the restart fails. */
+#include "gc_testing.h"
+
+#include "atom.h"
+#include "exceptions.h"
+#include "force.h"
+#include "pair_granular_opt.h"
+
+#include "gtest/gtest.h"
+
+#include <regex>
+#include <string>
+#include <vector>
+
+using gctest::Lmp;
+
+namespace {
+const char *MODEL = "jkr/marshall 2e8 0.7 0.33 0.01 damping marshall tangential marshall 0.3 "
+                    "rolling marshall 0.01 twisting marshall/jkr";
+
+int nprocs()
+{
+  int n;
+  MPI_Comm_size(MPI_COMM_WORLD, &n);
+  return n;
+}
+
+// 27 spheres on a slightly compressed 3 x 3 x 3 lattice on a JKR floor: every sphere touches
+// its lattice neighbours
+std::vector<std::string> bed(const std::string &pair = "granular/opt")
+{
+  return {"units si", "atom_style sphere", "atom_modify map array", "boundary p p f",
+          "newton off", "comm_modify vel yes", "lattice sc 1.995e-6",
+          "region box block 0 3 0 3 -1 4", "create_box 1 box",
+          "region cells block 0 3 0 2 0 2", "create_atoms 1 region cells",
+          "set group all diameter 2.0e-6", "set group all density 2500",
+          "pair_style " + pair, std::string("pair_coeff * * ") + MODEL,
+          std::string("fix floor all wall/gran granular ") + MODEL + " zplane -0.999e-6 NULL",
+          "neighbor 2e-7 bin", "neigh_modify every 1 delay 0 check yes",
+          "fix integrate all nve/sphere", "fix grav all gravity 9.81 vector 0 0 -1",
+          "timestep 5e-9", "thermo 0"};
+}
+
+// per-atom x y z of all atoms, gathered by ID
+std::vector<double> positions(Lmp &l)
+{
+  const int n = static_cast<int>(l.lmp->atom->natoms);
+  std::vector<double> x(3 * n);
+  for (int id = 1; id <= n; ++id) {
+    x[3 * (id - 1) + 0] = l.var("x[" + std::to_string(id) + "]");
+    x[3 * (id - 1) + 1] = l.var("y[" + std::to_string(id) + "]");
+    x[3 * (id - 1) + 2] = l.var("z[" + std::to_string(id) + "]");
+  }
+  return x;
+}
+
+LAMMPS_NS::bigint contacts(Lmp &l)
+{
+  auto *pair = dynamic_cast<LAMMPS_NS::PairGranularOpt *>(l.lmp->force->pair);
+  LAMMPS_NS::bigint mine = pair ? pair->contacts_computed() : -1, all = 0;
+  MPI_Allreduce(&mine, &all, 1, MPI_LMP_BIGINT, MPI_SUM, MPI_COMM_WORLD);
+  return all;
+}
+
+std::string error_of(const std::vector<std::string> &cmds)
+{
+  Lmp l;
+  try {
+    l.cmds(cmds);
+  } catch (LAMMPS_NS::LAMMPSException &e) {
+    return e.what();
+  }
+  return "no error";
+}
+}    // namespace
+
+// thresholds that every atom meets at once (time 0, commit every step): all sleep after run 1
+const char *ALL_SLEEP = "fix sleep all sleep/gran speed 1e3 force 1.0 wake 10.0 time 0 every 1";
+
+TEST(FixSleepGran, HeldAndSkipped)
+{
+  {
+    Lmp l;
+    l.cmds(bed());
+    l.cmd("run 1");
+    EXPECT_GT(contacts(l), 20) << "the lattice touches: without sleepers its contacts are computed";
+  }
+  Lmp l;
+  l.cmds(bed());
+  l.cmds({ALL_SLEEP, "compute nsleep all reduce sum f_sleep", "compute pl all pair/local force",
+          "compute fsum all reduce sum c_pl inputs local", "thermo_style custom step f_sleep c_nsleep c_fsum", "run 1"});
+  EXPECT_EQ(l.var("f_sleep[2]"), 27.0);
+  EXPECT_EQ(l.var("c_nsleep"), 27.0) << "per-atom flag";
+  EXPECT_EQ(l.var("f_sleep"), 0.0) << "awake atoms (the scalar)";
+  l.cmd("run 1");    // the pair forces of step 1 still had the velocities of step 1
+  const auto x0 = positions(l);
+  const double fsum0 = l.var("c_fsum");
+  l.cmd("run 500");
+  EXPECT_EQ(contacts(l), 0);
+  const auto x1 = positions(l);
+  for (size_t k = 0; k < x0.size(); ++k) EXPECT_EQ(x0[k], x1[k]) << "coordinate " << k;
+  // the contacts' forces recomputed from the kept history are the same (their damping part
+  // is zero in both: the bed does not move)
+  EXPECT_EQ(l.var("c_fsum"), fsum0);
+  EXPECT_NE(fsum0, 0.0);
+}
+
+// sphere 1 sleeps (the only member of the fix group), sphere 2 hits it at 0.3 m/s
+std::vector<std::string> impact(const std::string &hold)
+{
+  return {"units si", "atom_style sphere", "atom_modify map array", "boundary f f f",
+          "newton off", "comm_modify vel yes", "region box block -1e-5 1e-5 -1e-5 1e-5 -1e-5 1e-5",
+          "create_box 1 box", "create_atoms 1 single 0 0 0", "create_atoms 1 single 0.8e-6 0.3e-6 2.1e-6",
+          "set group all diameter 2.0e-6", "set group all density 2500", "group one id 1",
+          "group two id 2", "pair_style granular/opt", std::string("pair_coeff * * ") + MODEL,
+          "neighbor 2e-7 bin", "neigh_modify every 1 delay 0 check yes",
+          "velocity two set 0.01 -0.02 -0.3", "set atom 2 omega 1e4 -2e4 3e3",
+          "fix integrate all nve/sphere", "timestep 5e-9", "thermo 0", hold};
+}
+
+TEST(FixSleepGran, SleeperIsAFixedBody)
+{
+  if (nprocs() > 1) GTEST_SKIP() << "single-rank test";
+  Lmp a, b;
+  a.cmds(impact("fix sleep one sleep/gran speed 1e3 force 1.0 wake 1e3 time 0 every 1"));
+  b.cmds(impact("fix hold one freeze"));
+  a.cmd("run 1");
+  b.cmd("run 1");
+  EXPECT_EQ(a.var("f_sleep[2]"), 1.0);
+  a.cmd("run 3000");
+  b.cmd("run 3000");
+  EXPECT_GT(a.var("f_sleep[3]"), 0.0);
+  const char *q[] = {"x[2]", "y[2]", "z[2]", "vx[2]", "vy[2]", "vz[2]"};
+  for (auto *e : q) EXPECT_EQ(a.var(e), b.var(e)) << e;
+  EXPECT_EQ(a.var("x[1]"), 0.0);
+  // the impact happened: the sphere stuck to the sleeper or rebounded
+  EXPECT_GT(std::abs(b.var("vz[2]") + 0.3), 0.01);
+}
+
+TEST(FixSleepGran, WakesWhenPushed)
+{
+  if (nprocs() > 1) GTEST_SKIP() << "single-rank test";
+  // sphere 3 below sphere 1, touching it: both sleep; sphere 2 hits 1
+  auto cmds = impact("create_atoms 1 single 0 0 -1.999e-6");
+  cmds.insert(cmds.end(), {"set atom 3 diameter 2.0e-6 density 2500", "group bedg id 1 3"});
+  {
+    Lmp l;
+    l.cmds(cmds);
+    l.cmd("fix sleep bedg sleep/gran speed 1e3 force 1.0 wake 1e3 time 0 every 1");
+    l.cmd("run 3000");
+    EXPECT_EQ(l.var("f_sleep[4]"), 0.0) << "push below wake: nothing wakes";
+  }
+  // the impact pushes with ~3e-8 N, m U / t_c (F_C = 3 pi gamma R = 9.4e-8 N)
+  Lmp m;
+  m.cmds(cmds);
+  // the pair 1-3 snaps into JKR contact (3.6e-8 N): at rest means here a net force below 1e-6 N
+  m.cmds({"fix sleep bedg sleep/gran speed 1e3 force 1e-6 wake 1e-8 time 0 every 1", "run 1"});
+  EXPECT_EQ(m.var("f_sleep[2]"), 2.0) << "both at rest at step 1";
+  const double z1 = m.var("z[1]");
+  m.cmd("run 3000");
+  EXPECT_GE(m.var("f_sleep[4]"), 2.0) << "sphere 1 pushed, sphere 3 touching it";
+  EXPECT_NE(m.var("z[1]"), z1) << "sphere 1 moves once awake";
+}
+
+TEST(FixSleepGran, RestartKeepsTheFlags)
+{
+  const std::string file = "sleep_gran.restart";
+  {
+    Lmp l;
+    l.cmds(bed());
+    l.cmds({ALL_SLEEP, "run 1", "write_restart " + file});
+  }
+  Lmp l;
+  l.cmds({"read_restart " + file, "pair_style granular/opt", std::string("pair_coeff * * ") + MODEL,
+          "comm_modify vel yes", "neighbor 2e-7 bin",
+          std::string("fix floor all wall/gran granular ") + MODEL + " zplane -0.999e-6 NULL",
+          "fix integrate all nve/sphere",
+          // commits only every 10^6 steps: the flags can only come from the restart
+          "fix sleep all sleep/gran speed 1e3 force 1.0 wake 10.0 time 0 every 1000000", "run 0"});
+  EXPECT_EQ(l.var("f_sleep[2]"), 27.0);
+  EXPECT_EQ(l.var("f_sleep[3]"), 27.0) << "event count from the global restart";
+  int me;
+  MPI_Comm_rank(MPI_COMM_WORLD, &me);
+  if (me == 0) std::remove(file.c_str());
+}
+
+TEST(FixSleepGran, FlagsMigrateWithTheAtoms)
+{
+  Lmp l;
+  l.cmds(bed());
+  l.cmds({ALL_SLEEP, "run 1"});
+  l.cmd("displace_atoms all move 2.9925e-6 2.9925e-6 0 units box");
+  l.cmd("run 1");
+  const auto x0 = positions(l);
+  l.cmd("run 200");
+  EXPECT_EQ(l.var("f_sleep[2]"), 27.0);
+  EXPECT_EQ(contacts(l), 0);
+  const auto x1 = positions(l);
+  for (size_t k = 0; k < x0.size(); ++k) EXPECT_EQ(x0[k], x1[k]) << "coordinate " << k;
+}
+
+TEST(FixSleepGran, BadInput)
+{
+  auto err = [&](const std::string &fix, const std::string &pair = "granular/opt",
+                 const std::vector<std::string> &after = {}) {
+    auto c = bed(pair);
+    c.push_back(fix);
+    c.insert(c.end(), after.begin(), after.end());
+    c.push_back("run 0");
+    return error_of(c);
+  };
+  auto expect_match = [](const std::string &msg, const std::string &re) {
+    EXPECT_TRUE(std::regex_search(msg, std::regex(re))) << "message: " << msg << "\nexpected: " << re;
+  };
+  const std::string ok = "fix s all sleep/gran speed 1e-3 force 1e-8 wake 1e-7 time 1e-6";
+  EXPECT_EQ(err(ok), "no error");
+  expect_match(err("fix s all sleep/gran speed 0 force 1e-8 wake 1e-7 time 1e-6"), "sleep/gran speed must be > 0, got 0");
+  expect_match(err("fix s all sleep/gran speed 1e-3 force -1 wake 1e-7 time 1e-6"), "force must be > 0, got -1");
+  expect_match(err("fix s all sleep/gran speed 1e-3 force 1e-8 wake nan time 1e-6"), "wake must be > 0|Expected floating");
+  expect_match(err("fix s all sleep/gran speed 1e-3 force 1e-8 wake 1e-7 time -1"), "time must be >= 0, got -1");
+  expect_match(err(ok + " every 0"), "every must be >= 1, got 0");
+  expect_match(err(ok + " depth -2e-6"), "depth must be > 0, got -2e-6");
+  expect_match(err(ok + " bogus 1"), "Unknown fix sleep/gran keyword bogus");
+  expect_match(err("fix s all sleep/gran speed 1e-3 force 1e-8"), "needs the keywords speed, force, wake and time");
+  expect_match(err(ok, "granular"), "requires pair_style granular/opt.*not granular");
+  expect_match(err(ok, "granular/opt", {"fix late all gravity 1 vector 0 0 -1"}),
+               "must be defined after every fix that adds forces; fix late \\(gravity\\)");
+  expect_match(err(ok, "granular/opt",
+                   {"group none empty", "region ins block EDGE EDGE EDGE EDGE 3e-6 4e-6 units box",
+                    "fix s2 none sleep/gran speed 1e-3 force 1e-8 wake 1e-7 time 1e-6",
+                    "fix feed all deposit 1 1 100 4711 region ins near 2e-6 units box"}),
+               "Only one fix sleep/gran|does not contain the atoms");
+  {
+    auto c = bed();
+    c.insert(c.end(), {"group none empty", "region ins block EDGE EDGE EDGE EDGE 3e-6 4e-6 units box",
+                       "fix feed all deposit 1 1 100 4711 region ins near 2e-6 units box",
+                       "fix s none sleep/gran speed 1e-3 force 1e-8 wake 1e-7 time 1e-6", "run 0"});
+    expect_match(error_of(c), "group none does not contain the atoms that fix deposit feed inserts");
+  }
+  expect_match(error_of({"units si", "atom_style atomic", "region box block 0 1 0 1 0 1", "create_box 1 box",
+                         "fix s all sleep/gran speed 1 force 1 wake 1 time 0"}),
+               "requires atom attributes radius, rmass, omega and torque");
+}
