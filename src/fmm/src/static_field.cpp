@@ -402,6 +402,7 @@ void StaticSourceField::Impl::far_field() {
       cover_lo = std::min(cover_lo, *lo);
       cover_hi = std::max(cover_hi, *hi);
       prepare_far_field();
+      stats.estimated_error = res.estimated_error + far.estimated_error();
     }
     far.interpolate_at(phi, n, xs.data(), ys.data(), zs.data(), tpot.data(), tex.data(), tey.data(), tez.data());
   } else if (opts.farfield == FarField::Average) {

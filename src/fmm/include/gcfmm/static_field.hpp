@@ -76,7 +76,7 @@ struct StaticFieldStats {
 class StaticSourceField {
  public:
   //! default max targets per leaf of the target tree (set_target_leaf(); doc/fmm-static-sources.md)
-  static constexpr int kDefaultTargetLeaf = 16;
+  static constexpr int kDefaultTargetLeaf = 8;
 
   /** @throws std::invalid_argument as Options::validate() */
   explicit StaticSourceField(const Options &opts);
