@@ -62,13 +62,21 @@ void cuboid_field(double x1, double x2, double y1, double y2, double z1, double 
 void average_far_field(std::size_t n, const double *x, const double *y, const double *z, const double *q,
                        double x0, double y0, double lx, double ly, int images, double bed_zlo, double bed_zhi,
                        std::size_t begin, std::size_t end, double *pot, double *ex, double *ey, double *ez) {
+  if (end > n || begin > end) throw std::invalid_argument("gcfmm::average_far_field: bad target range");
+  double qsum = 0;
+  for (std::size_t j = 0; j < n; ++j) qsum += q[j];
+  average_far_field_of_charge(qsum, x, y, z, x0, y0, lx, ly, images, bed_zlo, bed_zhi, begin, end, pot, ex, ey, ez);
+}
+
+void average_far_field_of_charge(double qsum, const double *x, const double *y, const double *z, double x0,
+                                 double y0, double lx, double ly, int images, double bed_zlo, double bed_zhi,
+                                 std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
+                                 double *ez) {
   if (!(lx > 0) || !(ly > 0)) throw std::invalid_argument("gcfmm::average_far_field: periods must be positive");
   if (images < 0) throw std::invalid_argument("gcfmm::average_far_field: images must be >= 0");
   if (!(bed_zhi > bed_zlo))
     throw std::invalid_argument("gcfmm::average_far_field: need bed_zhi > bed_zlo (the bed height H_p)");
-  if (end > n || begin > end) throw std::invalid_argument("gcfmm::average_far_field: bad target range");
-  double qsum = 0;
-  for (std::size_t j = 0; j < n; ++j) qsum += q[j];
+  if (begin > end) throw std::invalid_argument("gcfmm::average_far_field: bad target range");
   if (qsum == 0.0) return;
   const double h = bed_zhi - bed_zlo;
   const double rho = qsum / (lx * ly * h);

@@ -244,31 +244,47 @@ void PeriodicFarField::evaluate(std::size_t n, const double *x, const double *y,
     throw std::invalid_argument("gcfmm::PeriodicFarField::evaluate: bad target range");
   if (nparts < 1 || part < 0 || part >= nparts)
     throw std::invalid_argument("gcfmm::PeriodicFarField::evaluate: need 0 <= part < nparts");
-  const int p = pxy_, pz = pz_, nn = p * p * pz;
-  double sx[32], sy[32], sz[32];
+  const int nn = pxy_ * pxy_ * pz_;
   // anterpolation: node charges W_b = sum_j q_j S(r_j) (exact total charge per box). Every
   // node sums over j in the same order whichever partition computes it, so splitting the x
   // nodes a in [a0, a1) among the partitions keeps W bit-identical.
   const bool split = sum && nparts > 1;
-  const int a0 = split ? p * part / nparts : 0, a1 = split ? p * (part + 1) / nparts : p;
-  Eigen::MatrixXd w = Eigen::MatrixXd::Zero(nn, nb_);
+  const int a0 = split ? pxy_ * part / nparts : 0, a1 = split ? pxy_ * (part + 1) / nparts : pxy_;
+  std::vector<double> w;
   // the boxes holding particles (targets) and charges (sources): taken over all n particles,
   // not over [begin, end), so that every partition applies the same products and the sum of
   // the partitions stays bit-identical to one evaluation of all targets
-  int src_lo = nb_, src_hi = 0, tgt_lo = nb_, tgt_hi = 0;
+  int src_lo, src_hi, tgt_lo, tgt_hi;
+  anterpolate(n, x, y, z, q, a0, a1, w, &src_lo, &src_hi, &tgt_lo, &tgt_hi);
+  // only the source boxes' node charges are nonzero (columns are contiguous)
+  if (split && src_hi > src_lo)
+    sum(w.data() + static_cast<std::size_t>(nn) * src_lo, static_cast<std::size_t>(nn) * (src_hi - src_lo));
+  Eigen::MatrixXd phi(nn, nb_);
+  apply(w.data(), phi.data(), src_lo, src_hi, tgt_lo, tgt_hi);
+  interpolate(phi.data(), x, y, z, begin, end, pot, ex, ey, ez);
+}
+
+void PeriodicFarField::anterpolate(std::size_t n, const double *x, const double *y, const double *z,
+                                   const double *q, int a0, int a1, std::vector<double> &w, int *src_lo,
+                                   int *src_hi, int *tgt_lo, int *tgt_hi) const {
+  const int p = pxy_, pz = pz_, nn = p * p * pz;
+  double sx[32], sy[32], sz[32];
+  w.assign(static_cast<std::size_t>(nn) * nb_, 0.0);
+  *src_lo = *tgt_lo = nb_;
+  *src_hi = *tgt_hi = 0;
   for (std::size_t j = 0; j < n; ++j) {
     double tx, ty, tz;
     const int b = locate(j, x[j], y[j], z[j], &tx, &ty, &tz);
-    tgt_lo = std::min(tgt_lo, b);
-    tgt_hi = std::max(tgt_hi, b + 1);
+    *tgt_lo = std::min(*tgt_lo, b);
+    *tgt_hi = std::max(*tgt_hi, b + 1);
     if (q[j] == 0.0) continue;
-    src_lo = std::min(src_lo, b);
-    src_hi = std::max(src_hi, b + 1);
+    *src_lo = std::min(*src_lo, b);
+    *src_hi = std::max(*src_hi, b + 1);
     if (a0 == a1) continue;
     interp_weights(tx, p, tab_xy_.data(), sx, nullptr);
     interp_weights(ty, p, tab_xy_.data(), sy, nullptr);
     interp_weights(tz, pz, tab_z_.data(), sz, nullptr);
-    double *col = w.col(b).data();
+    double *col = w.data() + static_cast<std::size_t>(nn) * b;
     for (int a = a0; a < a1; ++a) {
       const double qa = q[j] * sx[a];
       for (int bb = 0; bb < p; ++bb) {
@@ -278,12 +294,29 @@ void PeriodicFarField::evaluate(std::size_t n, const double *x, const double *y,
       }
     }
   }
-  // only the source boxes' node charges are nonzero (columns are contiguous)
-  if (split && src_hi > src_lo)
-    sum(w.col(src_lo).data(), static_cast<std::size_t>(nn) * (src_hi - src_lo));
-  Eigen::MatrixXd phi(nn, nb_);
-  apply(w.data(), phi.data(), src_lo, src_hi, tgt_lo, tgt_hi);
-  interpolate(phi.data(), x, y, z, begin, end, pot, ex, ey, ez);
+}
+
+void PeriodicFarField::node_potentials(std::size_t n, const double *x, const double *y, const double *z,
+                                       const double *q, std::vector<double> &phi) const {
+  if (!ready()) throw std::logic_error("gcfmm::PeriodicFarField::node_potentials: setup() not called");
+  const std::size_t size = static_cast<std::size_t>(pxy_) * pxy_ * pz_ * nb_;
+  phi.assign(size, 0.0);
+  if (n == 0) return;
+  std::vector<double> w;
+  int src_lo, src_hi, tgt_lo, tgt_hi;
+  anterpolate(n, x, y, z, q, 0, pxy_, w, &src_lo, &src_hi, &tgt_lo, &tgt_hi);
+  if (src_hi <= src_lo) return;  // no charge
+  // the targets may be anywhere in the column: the node potentials of every box
+  apply(w.data(), phi.data(), src_lo, src_hi, 0, nb_);
+}
+
+void PeriodicFarField::interpolate_at(const std::vector<double> &phi, std::size_t n, const double *x,
+                                      const double *y, const double *z, double *pot, double *ex, double *ey,
+                                      double *ez) const {
+  if (!ready()) throw std::logic_error("gcfmm::PeriodicFarField::interpolate_at: setup() not called");
+  if (phi.size() != static_cast<std::size_t>(pxy_) * pxy_ * pz_ * nb_)
+    throw std::invalid_argument("gcfmm::PeriodicFarField::interpolate_at: node potentials of another set-up");
+  interpolate(phi.data(), x, y, z, 0, n, pot, ex, ey, ez);
 }
 
 }  // namespace gcfmm

@@ -8,15 +8,20 @@ namespace gcfmm {
 
 void build_lists(const Tree &tree, const std::vector<Vec3> &shifts, double theta, double pair_limit,
                  InteractionLists &L) {
+  build_lists(tree, tree, shifts, theta, pair_limit, L);
+}
+
+void build_lists(const Tree &targets, const Tree &sources, const std::vector<Vec3> &shifts, double theta,
+                 double pair_limit, InteractionLists &L) {
   L.shifts = shifts;
   L.m2l.clear();
   L.p2p.clear();
   L.p2p_pairs = 0;
-  const std::size_t nn = tree.nodes.size();
+  const std::size_t nn = targets.nodes.size();
   L.m2l_offset.assign(nn + 1, 0);
   L.p2p_offset.assign(nn + 1, 0);
-  if (nn == 0) return;
-  const auto &nodes = tree.nodes;
+  if (nn == 0 || sources.nodes.empty()) return;
+  const auto &tnodes = targets.nodes, &snodes = sources.nodes;
   const double th2 = theta * theta;
   std::vector<std::pair<std::int32_t, std::int32_t>> stack;
   stack.reserve(1024);
@@ -28,8 +33,8 @@ void build_lists(const Tree &tree, const std::vector<Vec3> &shifts, double theta
     while (!stack.empty()) {
       const auto [a, b] = stack.back();
       stack.pop_back();
-      const Node &A = nodes[a];
-      const Node &B = nodes[b];
+      const Node &A = tnodes[a];
+      const Node &B = snodes[b];
       const double dx = A.center.x - B.center.x - sh.x, dy = A.center.y - B.center.y - sh.y,
                    dz = A.center.z - B.center.z - sh.z;
       const double d2 = dx * dx + dy * dy + dz * dz;

@@ -18,25 +18,11 @@ void Solver::Impl::sort_charges(const double *q) {
     }
 }
 
-// Upward pass: P2M at leaves (eq. (3.9)), M2M to parents (eq. (3.10)); children have larger
-// indices than their parents, so one reverse sweep suffices. Done for all nodes by every part:
-// splitting the P2M would need the leaf multipoles summed over the parts, and at N = 200,000
-// that sum (~all nodes x expansion size doubles) cost more than the P2M it saved
-// (doc/benchmarks.md, "2 MPI ranks").
-void Solver::Impl::upward() {
-  const auto &nodes = tree.nodes;
-  const auto &xs = tree.xs, &ys = tree.ys, &zs = tree.zs;
-  std::fill(multipole.begin(), multipole.end(), 0.0);
-  for (std::size_t i = nodes.size(); i-- > 0;) {
-    const Node &A = nodes[i];
-    double *Mi = multipole_of(i);
-    if (A.leaf())
-      ops->p2m_batch(A.count(), xs.data() + A.begin, ys.data() + A.begin, zs.data() + A.begin,
-                     sorted_q.data() + A.begin, A.center, Mi);
-    ops->symmetrize(Mi);
-    if (A.parent >= 0) ops->m2m(Mi, A.center - nodes[A.parent].center, multipole_of(A.parent));
-  }
-}
+// Upward pass: P2M at leaves (eq. (3.9)), M2M to parents (eq. (3.10)) (detail::upward_pass).
+// Done for all nodes by every part: splitting the P2M would need the leaf multipoles summed
+// over the parts, and at N = 200,000 that sum (~all nodes x expansion size doubles) cost more
+// than the P2M it saved (doc/benchmarks.md, "2 MPI ranks").
+void Solver::Impl::upward() { upward_pass(tree, sorted_q.data(), *ops, multipole); }
 
 // M2L (eq. (3.11)) into the local expansions of the nodes that hold targets of this part.
 void Solver::Impl::m2l(const TargetRange &t) {
@@ -105,24 +91,8 @@ void Solver::Impl::far_field(const TargetRange &t, int part, int nparts, const P
     far.evaluate(n, xs.data(), ys.data(), zs.data(), sorted_q.data(), t.begin, t.end, sorted_pot.data(),
                  sorted_ex.data(), sorted_ey.data(), sorted_ez.data(), part, nparts, sum);
   } else if (opts.farfield == FarField::Average) {
-    double blo = opts.bed_zlo * inv_h, bhi = opts.bed_zhi * inv_h;
-    if (std::isnan(blo)) {
-      bool any = false;
-      for (std::size_t k = 0; k < n; ++k)
-        if (sorted_q[k] != 0.0) {
-          blo = any ? std::min(blo, zs[k]) : zs[k];
-          bhi = any ? std::max(bhi, zs[k]) : zs[k];
-          any = true;
-        }
-      if (!any) return;
-    }
-    if (!(bhi - blo > 1e-6 * std::min(slx, sly))) {
-      // a flat layer of charges (e.g. one charged particle): the slab becomes a sheet; give it
-      // a small thickness (relative change of the far field ~ 1e-6)
-      const double mid = 0.5 * (blo + bhi), half = 0.5e-6 * std::min(slx, sly);
-      blo = mid - half;
-      bhi = mid + half;
-    }
+    double blo, bhi;
+    if (!average_bed(opts, inv_h, n, zs.data(), sorted_q.data(), slx, sly, blo, bhi)) return;
     // the potential part apart, for energy_potential() (eq. (4.10))
     std::fill(sorted_average_pot.begin() + t.begin, sorted_average_pot.begin() + t.end, 0.0);
     average_far_field(n, xs.data(), ys.data(), zs.data(), sorted_q.data(), sx0, sy0, slx, sly, opts.images, blo, bhi,

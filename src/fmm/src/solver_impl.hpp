@@ -69,6 +69,53 @@ inline double length_unit(double extent) {
   return std::ldexp(1.0, e);
 }
 
+// Upward pass (doc/theory.md, eqs. (3.9), (3.10)): P2M at the leaves, M2M to the parents, for
+// all nodes of `tree` with the charges q in tree order; `multipole` holds ops.size() doubles
+// per node (overwritten). Children have larger indices than their parents, so one reverse
+// sweep suffices. Shared by Solver and StaticSourceField.
+inline void upward_pass(const Tree &tree, const double *q, Operators &ops, std::vector<double> &multipole) {
+  const auto &nodes = tree.nodes;
+  const auto &xs = tree.xs, &ys = tree.ys, &zs = tree.zs;
+  const std::size_t size = ops.size();
+  multipole.assign(nodes.size() * size, 0.0);
+  for (std::size_t i = nodes.size(); i-- > 0;) {
+    const Node &A = nodes[i];
+    double *Mi = multipole.data() + i * size;
+    if (A.leaf())
+      ops.p2m_batch(A.count(), xs.data() + A.begin, ys.data() + A.begin, zs.data() + A.begin, q + A.begin, A.center,
+                    Mi);
+    ops.symmetrize(Mi);
+    if (A.parent >= 0) ops.m2m(Mi, A.center - nodes[A.parent].center, multipole.data() + A.parent * size);
+  }
+}
+
+// The bed of the average far field (doc/theory.md, eq. (4.7)) in units of h: Options::bed_zlo
+// and bed_zhi if given, else the z range of the charged particles (zs, q: n particles in units
+// of h); a flat layer (e.g. one charged particle) becomes a slab of thickness 1e-6 min(slx, sly)
+// (relative change of the far field ~1e-6). Returns false when no particle is charged (no
+// automatic bed: the far field is zero). Shared by Solver and StaticSourceField.
+inline bool average_bed(const Options &o, double inv_h, std::size_t n, const double *zs, const double *q, double slx,
+                        double sly, double &blo, double &bhi) {
+  blo = o.bed_zlo * inv_h;
+  bhi = o.bed_zhi * inv_h;
+  if (std::isnan(blo)) {
+    bool any = false;
+    for (std::size_t k = 0; k < n; ++k)
+      if (q[k] != 0.0) {
+        blo = any ? std::min(blo, zs[k]) : zs[k];
+        bhi = any ? std::max(bhi, zs[k]) : zs[k];
+        any = true;
+      }
+    if (!any) return false;
+  }
+  if (!(bhi - blo > 1e-6 * std::min(slx, sly))) {
+    const double mid = 0.5 * (blo + bhi), half = 0.5e-6 * std::min(slx, sly);
+    blo = mid - half;
+    bhi = mid + half;
+  }
+  return true;
+}
+
 //! The targets of one work partition: sorted particle indices [begin, end).
 struct TargetRange {
   std::size_t begin = 0, end = 0;

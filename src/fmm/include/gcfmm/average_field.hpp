@@ -58,6 +58,16 @@ void average_far_field(std::size_t n, const double *x, const double *y, const do
                        double x0, double y0, double lx, double ly, int images, double bed_zlo, double bed_zhi,
                        std::size_t begin, std::size_t end, double *pot, double *ex, double *ey, double *ez);
 
+/**
+ * @brief average_far_field() given the total charge per cell qsum = sum(q) of the sources
+ * directly, at targets (x, y, z)[begin, end) that need not be the sources (StaticSourceField:
+ * the sleeping charges' far field at the awake particles). The same formula; ADDS.
+ */
+void average_far_field_of_charge(double qsum, const double *x, const double *y, const double *z, double x0,
+                                 double y0, double lx, double ly, int images, double bed_zlo, double bed_zhi,
+                                 std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
+                                 double *ez);
+
 }  // namespace gcfmm
 
 #endif

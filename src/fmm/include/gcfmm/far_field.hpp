@@ -126,6 +126,28 @@ class PeriodicFarField {
                 std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
                 double *ez, int part = 0, int nparts = 1, const PartSum &sum = nullptr) const;
 
+  /**
+   * @brief The source half of evaluate(), for a source set that stays fixed while the targets
+   * move (StaticSourceField): the node potentials Phi_t of every box t of the column
+   * (doc/theory.md, eq. (4.6): anterpolation W_b, then Phi_t = sum_b K_{t-b} W_b), the same
+   * code path as evaluate(). phi receives p^2 pz x boxes() doubles (all zero without charge).
+   * Cost O(n p^2 pz) plus the operator from the source boxes to all boxes.
+   * @throws std::logic_error if setup was not called; std::invalid_argument if a source lies
+   *         outside the stored geometry.
+   */
+  void node_potentials(std::size_t n, const double *x, const double *y, const double *z, const double *q,
+                       std::vector<double> &phi) const;
+
+  /**
+   * @brief The target half: ADDS the far-field potential and field interpolated from node
+   * potentials of node_potentials() (this set-up) at the points (x, y, z)[0, n), which need
+   * not be the sources; pot may be null. Cost O(n p^2 pz), independent of the sources.
+   * @throws std::logic_error if setup was not called; std::invalid_argument if phi is not of
+   *         this set-up's size or a point lies outside the stored geometry.
+   */
+  void interpolate_at(const std::vector<double> &phi, std::size_t n, const double *x, const double *y,
+                      const double *z, double *pot, double *ex, double *ey, double *ez) const;
+
   /// @brief Estimated relative RMS error of the far field: the larger of the error measured
   /// for these parameters in the calibration (setup only) and 20 x the RMS error of the
   /// interpolated kernel gradient over random sample pairs divided by the sheet field
@@ -154,6 +176,10 @@ class PeriodicFarField {
   // node charges -> node potentials, (p^2 pz) x nb, from the source boxes [src_lo, src_hi) at
   // the target boxes [tgt_lo, tgt_hi) only (the other columns of phi are zero)
   void apply(const double *w, double *phi, int src_lo, int src_hi, int tgt_lo, int tgt_hi) const;
+  // node charges W (p^2 pz x nb, x nodes a in [a0, a1) only) of the charges, and the box
+  // spans holding any particle (tgt) and any nonzero charge (src); [lo, hi) = [nb, 0) if none
+  void anterpolate(std::size_t n, const double *x, const double *y, const double *z, const double *q, int a0,
+                   int a1, std::vector<double> &w, int *src_lo, int *src_hi, int *tgt_lo, int *tgt_hi) const;
   int locate(std::size_t i, double x, double y, double z, double *tx, double *ty, double *tz) const;
   void interpolate(const double *phi, const double *x, const double *y, const double *z,
                    std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,

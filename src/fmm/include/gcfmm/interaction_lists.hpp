@@ -36,14 +36,23 @@ struct InteractionLists {
   std::size_t p2p_pairs = 0;              //!< number of particle pairs in the P2P list
 };
 
-/** @brief Build the lists by dual-tree traversal for every shift.
- *  @param tree built tree (targets and sources are the same particles)
+/** @brief Build the lists by dual-tree traversal for every shift (targets and sources are the
+ *  same particles: the tree against itself, as build_lists(tree, tree, ...)).
+ *  @param tree built tree
  *  @param shifts image shifts of the sources (the free-space case is the single shift 0)
  *  @param theta MAC opening angle, 0 < theta < 1
  *  @param pair_limit accepted pairs with n_A n_B <= pair_limit go to P2P instead of M2L
  *  @param lists output */
 void build_lists(const Tree &tree, const std::vector<Vec3> &shifts, double theta, double pair_limit,
                  InteractionLists &lists);
+
+/** @brief The same traversal between two trees: the targets' tree against the sources' tree
+ *  shifted by each shift (StaticSourceField). Interaction::target indexes `targets`' nodes,
+ *  Interaction::source `sources`' nodes; the offsets are over the target nodes. Nothing is
+ *  assumed about where the targets lie relative to the sources. Either tree may be empty
+ *  (no entries). */
+void build_lists(const Tree &targets, const Tree &sources, const std::vector<Vec3> &shifts, double theta,
+                 double pair_limit, InteractionLists &lists);
 
 }  // namespace gcfmm
 
