@@ -9,6 +9,9 @@
 
 #include "fix_coul_fmm.h"
 
+#include "coul_fmm_sleepers.h"
+#include "fix_sleep_gran.h"
+
 #include "atom.h"
 #include "comm.h"
 #include "domain.h"
@@ -51,8 +54,11 @@ enum : int {
   EVAL_SLOPE_A = 15,  // unwrapped positions at the two evaluations the slope was taken over
   EVAL_SLOPE_B = 18,  // (3 each): the trend of a pair inside the slope, for the near refresh
   EVAL_IN_SLOPE = 21, // 1 if the slope covers this atom's pairs (it existed at both evaluations)
-  EVAL_COLS = 22
+  EVAL_ASLEEP = 22,   // 1 if the atom was a static source (fix sleep/gran) at the evaluation
+  EVAL_COLS = 23
 };
+// restart files before EVAL_ASLEEP hold 22 columns
+static constexpr int EVAL_COLS_V1 = 22;
 
 // restart format: the global list starts with this marker (older files start with the step of
 // the last evaluation, >= -1, and hold no charge checksum: they are evaluated afresh)
@@ -92,7 +98,7 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
     near_delta(nullptr), nmax_ghost(0), list(nullptr), check_every(0), fresh(nullptr),
     nmax_check(0), check_last(0.0), check_max(0.0), check_num(0.0), check_den(0.0),
     near_now(nullptr), near_then(nullptr), nmax_near(0), slope_steps(0.0),
-    logged(false)
+    logged(false), sleepers_static(true), sleep_fix(nullptr), sleeper_pair_energy(0.0)
 {
   scalar_flag = 1;
   extscalar = 1;
@@ -206,6 +212,13 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
       near_cutoff = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
       if (!(near_cutoff >= 0.0))
         error->all(FLERR, iarg + 1, "Fix coul/fmm near cutoff must be >= 0, got {}", arg[iarg + 1]);
+      iarg += 2;
+    } else if (key == "sleepers") {
+      need(1);
+      const std::string v = arg[iarg + 1];
+      if (v != "static" && v != "full")
+        error->all(FLERR, iarg + 1, "Fix coul/fmm sleepers must be static or full, got {}", v);
+      sleepers_static = v == "static";
       iarg += 2;
     } else {
       error->all(FLERR, iarg, "Unknown fix coul/fmm keyword: {}", key);
@@ -342,7 +355,8 @@ void FixCoulFMM::init()
   }
   // the solver (tree memory, far-field operator) is kept across runs; the boundary is the only
   // option init() can change
-  if (!solver || solver_boundary != (int) opts->boundary) {
+  const bool solver_new = !solver || solver_boundary != (int) opts->boundary;
+  if (solver_new) {
     try {
       solver = std::make_unique<gcfmm::Solver>(*opts);
     } catch (std::exception &e) {
@@ -351,6 +365,7 @@ void FixCoulFMM::init()
     solver_boundary = (int) opts->boundary;
   }
   logged = false;
+  init_sleepers(solver_new);
 
   // near refresh: a half list without newton (each pair once per rank that owns one of its
   // atoms, so no reverse communication) of the pairs closer than the near cutoff, ghosts out to
@@ -528,8 +543,9 @@ void FixCoulFMM::gather_charges()
   tagint *tag = atom->tag;
 
   buf.clear();
+  const bool split = split_active() && split_now;
   for (int i = 0; i < nlocal; i++) {
-    if (!(mask[i] & groupbit) || q[i] == 0.0) continue;
+    if (!(mask[i] & groupbit) || q[i] == 0.0 || (split && sleepers->asleep(i))) continue;
     buf.insert(buf.end(), {(double) tag[i], x[i][0], x[i][1], x[i][2], q[i]});
   }
   const int nprocs = comm->nprocs;
@@ -591,8 +607,11 @@ FixCoulFMM::Continuity FixCoulFMM::field_continuity()
   // [0] the hash sum of the evaluation's charges still present, [1] atoms whose charge differs
   // from the evaluation's (a created atom has charge 0 there, set_arrays), [2] those of them
   // that were charged at the evaluation (changed, not added)
-  uint64_t local[3] = {0, 0, 0}, all[3];
+  // [3] charged atoms that were static sources (asleep) at the evaluation and are awake now: they
+  // have no stored field, like added atoms
+  uint64_t local[4] = {0, 0, 0, 0}, all[4];
   const tagint *tag = atom->tag;
+  if (split_active()) sleepers->use(sleep_fix->sleeping(), sleep_fix->generation());
   for (int i = 0; i < atom->nlocal; i++) {
     const double q = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
     const double q_then = eval_state[i][EVAL_Q];
@@ -601,10 +620,12 @@ FixCoulFMM::Continuity FixCoulFMM::field_continuity()
       local[1]++;
       if (q_then != 0.0) local[2]++;
     }
+    if (q != 0.0 && eval_state[i][EVAL_ASLEEP] != 0.0 && !(split_active() && sleepers->asleep(i)))
+      local[3]++;
   }
-  MPI_Allreduce(local, all, 3, MPI_UINT64_T, MPI_SUM, world);
+  MPI_Allreduce(local, all, 4, MPI_UINT64_T, MPI_SUM, world);
   if (all[0] != charges_computed || all[2] != 0) return Continuity::NONE;
-  return all[1] == 0 ? Continuity::SAME : Continuity::ADDED;
+  return all[1] == 0 && all[3] == 0 ? Continuity::SAME : Continuity::ADDED;
 }
 
 /* ----------------------------------------------------------------------
@@ -656,6 +677,12 @@ void FixCoulFMM::compute_field(bool with_slope)
     for (int k = 0; k < 3; k++) st[EVAL_X + k] = xu[k];
     st[EVAL_Q] = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
     if (new_slope) st[EVAL_IN_SLOPE] = st[EVAL_Q] != 0.0 ? 1.0 : 0.0;
+    // a static source gets no field, so no slope; awake again it starts as an added atom
+    st[EVAL_ASLEEP] = split_active() && sleepers->asleep(i) ? 1.0 : 0.0;
+    if (st[EVAL_ASLEEP] != 0.0) {
+      for (int k = 0; k < 4; k++) st[EVAL_SLOPE + k] = 0.0;
+      st[EVAL_IN_SLOPE] = 0.0;
+    }
   }
   if (new_slope) slope_steps = steps;
   // what the stored field belongs to (field_continuity)
@@ -675,7 +702,8 @@ void FixCoulFMM::compute_field(bool with_slope)
   double sums[2] = {0.0, 0.0};
   for (int i = 0; i < nlocal; i++) {
     double *st = eval_state[i];
-    const double q2 = st[EVAL_Q] * st[EVAL_Q];
+    // static sources have no field to predict
+    const double q2 = st[EVAL_ASLEEP] != 0.0 ? 0.0 : st[EVAL_Q] * st[EVAL_Q];
     for (int k = 0; k < 4; k++) {
       const double predicted = field[i][k];
       if (k < 3) {
@@ -730,17 +758,92 @@ void FixCoulFMM::adapt_stride(double error)
 }
 
 /* ----------------------------------------------------------------------
+   fix sleep/gran: with keyword sleepers static (the default) the sleeping charges are a static
+   source (coul_fmm_sleepers.h): not gathered, not targets (a sleeper does not move, and fix
+   sleep/gran zeroes its force), their field at the awake atoms from a StaticSourceField built
+   once per change of the sleeping set
+------------------------------------------------------------------------- */
+
+void FixCoulFMM::init_sleepers(bool solver_new)
+{
+  auto fixes = modify->get_fix_by_style("^sleep/gran$");
+  sleep_fix = fixes.empty() ? nullptr : dynamic_cast<FixSleepGran *>(fixes.front());
+  if (!sleep_fix || !sleepers_static) {
+    sleepers.reset();
+    return;
+  }
+  if (opts->boundary == gcfmm::Boundary::Periodic2D && opts->farfield == gcfmm::FarField::Average)
+    error->all(FLERR,
+               "Fix coul/fmm {} farfield average cannot treat the sleepers of fix sleep/gran {} as "
+               "a static source (the average field is no pair interaction): use farfield exact or "
+               "none, or keyword sleepers full",
+               id, sleep_fix->id);
+  if (thermo_virial)
+    error->all(FLERR,
+               "Fix coul/fmm {}: the virial with the static sleepers of fix sleep/gran {} would "
+               "lack the sleepers' share (their forces are not computed): use keyword sleepers "
+               "full, or fix_modify {} virial no",
+               id, sleep_fix->id, id);
+  if (solver_new || !sleepers) {
+    try {
+      sleepers = std::make_unique<CoulFMMSleepers>(lmp, *opts, groupbit);
+    } catch (std::exception &e) {
+      error->all(FLERR, "Fix coul/fmm: FMM library: {}", e.what());
+    }
+  }
+}
+
+namespace {
+// a coincidence involving a static source, with its message in atom IDs
+struct SleeperCoincidence {
+  std::string message;
+};
+}    // namespace
+
+// the sleepers' field at this rank's share of the awake targets (the reduce-scatter of
+// evaluate_into() sums the shares; the solver's own parts are disjoint the same way)
+void FixCoulFMM::add_sleepers_field(size_t n, double *pot, double *ex, double *ey, double *ez)
+{
+  const size_t first = n * comm->me / comm->nprocs, last = n * (comm->me + 1) / comm->nprocs;
+  try {
+    sleeper_qpot_local = sleepers->add_field(n, gx.data(), gy.data(), gz.data(), gq.data(), first,
+                                             last, pot, ex, ey, ez);
+  } catch (gcfmm::CoincidentParticles &e) {
+    throw SleeperCoincidence{fmt::format(
+        "atom {} is at the position of the sleeping atom {} (closer than {:g} of the solver's "
+        "length unit): their Coulomb force is not defined",
+        gtag[first + e.first()], sleepers->source_tag(e.second()), gcfmm::kCoincidenceRadius)};
+  }
+}
+
+/* ----------------------------------------------------------------------
    the FMM field at the current positions: out[i][col .. col+3] = Ex, Ey, Ez, phi (LAMMPS
    units) for the local atoms, zero for atoms outside the group or uncharged
 ------------------------------------------------------------------------- */
 
-void FixCoulFMM::evaluate_into(double **out, int col)
+void FixCoulFMM::evaluate_into(double **out, int col, bool split)
 {
+  if (sleep_fix && sleepers) sleepers->use(sleep_fix->sleeping(), sleep_fix->generation());
+  split_now = split;
   gather_charges();
+  split = split_active() && split;
   const size_t n = gtag.size();
   const int nlocal = atom->nlocal;
   for (int i = 0; i < nlocal; i++)
     for (int k = 0; k < 4; k++) out[i][col + k] = 0.0;
+  if (split) {
+    sleeper_pair_energy = sleeper_qpot_local = 0.0;
+    // the same sleepers on every rank: a failure here is seen by all
+    try {
+      sleepers->prepare();
+    } catch (gcfmm::CoincidentParticles &e) {
+      error->all(FLERR, "Fix coul/fmm: sleeping atoms {} and {} are at the same position: their "
+                 "Coulomb force is not defined", sleepers->source_tag(e.first()),
+                 sleepers->source_tag(e.second()));
+    } catch (std::exception &e) {
+      error->all(FLERR, "Fix coul/fmm: FMM library (static sleepers): {}", e.what());
+    }
+  }
   if (n == 0) return;
 
   result.assign(4 * n, 0.0);
@@ -764,6 +867,9 @@ void FixCoulFMM::evaluate_into(double **out, int col)
     // the potential whose energy 1/2 sum q_i u_i has minus the applied forces as gradient
     // (differs from pot only for farfield average; doc/theory.md, eq. (4.10))
     solver->energy_potential(pot);
+    if (split) add_sleepers_field(n, pot, ex, ey, ez);
+  } catch (SleeperCoincidence &e) {
+    failure = e.message;
   } catch (gcfmm::CoincidentParticles &e) {
     failure = fmt::format("atoms {} and {} are at the same position (closer than {:g} of the "
                           "solver's length unit): their Coulomb force is not defined",
@@ -788,6 +894,11 @@ void FixCoulFMM::evaluate_into(double **out, int col)
     failure.resize(len);
     MPI_Bcast(&failure[0], len, MPI_CHAR, first, world);
     error->all(FLERR, Error::NOLASTLINE, "Fix coul/fmm: FMM library: {}", failure);
+  }
+  if (split) {
+    double all = 0.0;
+    MPI_Allreduce(&sleeper_qpot_local, &all, 1, MPI_DOUBLE, MPI_SUM, world);
+    sleeper_pair_energy = 0.5 * force->qqrd2e * all;
   }
 
   // every target was computed by exactly one rank (zero elsewhere): a reduce-scatter in the
@@ -965,9 +1076,12 @@ void FixCoulFMM::measure_mts_error()
     memory->destroy(fresh);
     memory->create(fresh, nmax_check, 4, "coul/fmm:fresh");
   }
-  evaluate_into(fresh, 0);
+  // with static sleepers: against a full evaluation of all charges, at the awake atoms (the
+  // error of the split and of the time stepping together)
+  evaluate_into(fresh, 0, false);
   double sums[2] = {0.0, 0.0}, all[2];
   for (int i = 0; i < nlocal; i++) {
+    if (split_active() && sleepers->asleep(i)) continue;
     const double q2 = atom->q[i] * atom->q[i];
     for (int k = 0; k < 3; k++) {
       sums[0] += q2 * (field[i][k] - fresh[i][k]) * (field[i][k] - fresh[i][k]);
@@ -1027,6 +1141,9 @@ double FixCoulFMM::compute_scalar()
     MPI_Allreduce(&energy_local, &energy_all, 1, MPI_DOUBLE, MPI_SUM, world);
     energy_summed = true;
   }
+  // static sleepers: their pair energy with the awake charges (constant between evaluations)
+  // and among themselves (once per sleeping set)
+  if (split_active()) return energy_all + sleeper_pair_energy + force->qqrd2e * sleepers->source_energy();
   return energy_all;
 }
 
@@ -1070,6 +1187,7 @@ double FixCoulFMM::memory_usage()
   double bytes = (4.0 + EVAL_COLS) * atom->nmax * sizeof(double) +
       (double) NEAR_COMM * nmax_ghost * sizeof(double) + 8.0 * nmax_near * sizeof(double);
   bytes += (double) (gx.capacity() * 14) * sizeof(double);    // gathered atoms and results
+  if (sleepers) bytes += sleepers->memory_usage();
   return bytes;
 }
 
@@ -1183,9 +1301,11 @@ void FixCoulFMM::unpack_restart(int nlocal, int nth)
   double **extra = atom->extra;
   int m = 0;
   for (int i = 0; i < nth; i++) m += static_cast<int>(extra[nlocal][m]);
+  // files written before EVAL_ASLEEP hold EVAL_COLS_V1 columns: the rest start at zero
+  const int cols = MIN(EVAL_COLS, MAX(EVAL_COLS_V1, static_cast<int>(extra[nlocal][m]) - 5));
   m++;
   for (int k = 0; k < 4; k++) field[nlocal][k] = extra[nlocal][m++];
-  for (int k = 0; k < EVAL_COLS; k++) eval_state[nlocal][k] = extra[nlocal][m++];
+  for (int k = 0; k < EVAL_COLS; k++) eval_state[nlocal][k] = k < cols ? extra[nlocal][m++] : 0.0;
 }
 
 int FixCoulFMM::size_restart(int /*nlocal*/)

@@ -29,6 +29,7 @@ struct Options;
 }    // namespace gcfmm
 
 namespace LAMMPS_NS {
+class CoulFMMSleepers;
 
 // Coulomb forces between the charged atoms of a group by the FMM core library (src/fmm):
 // free space (boundary f f f) or periodic in x and y and open in z (boundary p p f).
@@ -110,6 +111,17 @@ class FixCoulFMM : public Fix {
 
   int ilevel_respa;    // rRESPA level at which the Coulomb force is applied (outermost)
 
+  // fix sleep/gran: the sleeping charges as a static source (keyword sleepers static)
+  bool sleepers_static;                      // keyword sleepers: static (true) or full
+  class FixSleepGran *sleep_fix;
+  std::unique_ptr<CoulFMMSleepers> sleepers;
+  double sleeper_pair_energy;                // C/2 sum_awake q pot^sleepers at the last evaluation
+  bool split_now = true;                     // this evaluation splits (false: a full one)
+  bool split_active() const { return sleepers && sleep_fix; }
+  void init_sleepers(bool solver_new);
+  void add_sleepers_field(size_t n, double *pot, double *ex, double *ey, double *ez);
+  double sleeper_qpot_local = 0.0;           // this rank's sum q pot^sleepers of the last one
+
   void check_other_coul_fmm_fixes();
   bool stored_field_valid();
   enum class Continuity { NONE, SAME, ADDED };
@@ -121,7 +133,7 @@ class FixCoulFMM : public Fix {
   double trend_factor(double steps) const;
   void advance_field();
   void remember_positions();
-  void evaluate_into(double **out, int col);
+  void evaluate_into(double **out, int col, bool split = true);
   void measure_mts_error();
   void apply_field(int vflag);
   void gather_charges();

@@ -40,7 +40,7 @@ enum RestartSlot { R_SLEEP_EVENTS, R_WAKE_EVENTS, R_NSLOTS };
 
 FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), speed_sleep(-1.0), force_sleep(-1.0), force_wake(-1.0), rest_time(-1.0),
-    depth(0.0), depth_bin(0.0), every(100), rest_steps_needed(0), asleep(nullptr),
+    depth(0.0), every(100), rest_steps_needed(0), asleep(nullptr),
     rest_steps(nullptr), push(nullptr), wake_mark(nullptr), comm_mode(COMM_FLAGS),
     set_generation(0), nsleeping_all(0), nsleep_events(0), nwake_events(0), pair_checked(0)
 {
@@ -82,7 +82,6 @@ FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
   }
   if (speed_sleep < 0.0 || force_sleep < 0.0 || force_wake < 0.0 || rest_time < 0.0)
     error->all(FLERR, "Fix {} needs the keywords speed, force, wake and time", style);
-  depth_bin = depth;    // columns of side depth
 
   scalar_flag = 1;
   vector_flag = 1;
@@ -344,13 +343,19 @@ void FixSleepGran::fall_asleep()
 }
 
 /* ----------------------------------------------------------------------
-   highest top (z + radius) of the bed per column of side `depth` in x, y
+   highest top (z + radius) of the bed per column of x, y
 ------------------------------------------------------------------------- */
 
 void FixSleepGran::surface_heights(std::vector<double> &top, int &nbx, int &nby) const
 {
-  nbx = MAX(1, static_cast<int>(domain->xprd / depth_bin));
-  nby = MAX(1, static_cast<int>(domain->yprd / depth_bin));
+  // columns one particle wide (the largest diameter): wider ones would put the particles of a
+  // valley of the rough surface below a neighbouring peak
+  double rmax = 0.0, rmax_all = 0.0;
+  for (int i = 0; i < atom->nlocal; i++) rmax = MAX(rmax, atom->radius[i]);
+  MPI_Allreduce(&rmax, &rmax_all, 1, MPI_DOUBLE, MPI_MAX, world);
+  const double side = rmax_all > 0.0 ? 2.0 * rmax_all : depth;
+  nbx = MAX(1, static_cast<int>(domain->xprd / side));
+  nby = MAX(1, static_cast<int>(domain->yprd / side));
   std::vector<double> mine(static_cast<size_t>(nbx) * nby, -1.0e300);
   top.assign(mine.size(), -1.0e300);
   double **x = atom->x, **v = atom->v;

@@ -71,7 +71,7 @@ class FixSleepGran : public Fix {
   bigint sleeping_count() const { return nsleeping_all; }
 
  private:
-  double speed_sleep, force_sleep, force_wake, rest_time, depth, depth_bin;
+  double speed_sleep, force_sleep, force_wake, rest_time, depth;
   int every, rest_steps_needed;
 
   double *asleep;        // 1.0 sleeping, 0.0 awake (local + ghost)

@@ -1,0 +1,129 @@
+/* ----------------------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+#include "coul_fmm_sleepers.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "domain.h"
+
+#include "gcfmm/options.hpp"
+#include "gcfmm/static_field.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+using namespace LAMMPS_NS;
+
+CoulFMMSleepers::CoulFMMSleepers(LAMMPS *lmp, const gcfmm::Options &opts, int groupbit_in) :
+    Pointers(lmp), field(new gcfmm::StaticSourceField(opts)), groupbit(groupbit_in), flags(nullptr),
+    generation(-1), built_generation(-2), built_box{0, 0, 0, 0, 0, 0}, nrebuilds(0)
+{
+}
+
+CoulFMMSleepers::~CoulFMMSleepers() = default;
+
+void CoulFMMSleepers::use(const double *asleep, bigint gen)
+{
+  flags = asleep;
+  generation = gen;
+}
+
+/* ----------------------------------------------------------------------
+   the charged sleepers of the group on every rank, sorted by atom ID
+------------------------------------------------------------------------- */
+
+void CoulFMMSleepers::gather()
+{
+  std::vector<double> mine;
+  double **x = atom->x;
+  double *q = atom->q;
+  for (int i = 0; i < atom->nlocal; i++) {
+    if (!(atom->mask[i] & groupbit) || q[i] == 0.0 || !asleep(i)) continue;
+    mine.insert(mine.end(), {(double) atom->tag[i], x[i][0], x[i][1], x[i][2], q[i]});
+  }
+  const int nprocs = comm->nprocs;
+  std::vector<int> counts(nprocs), displs(nprocs);
+  int n = (int) mine.size(), total = 0;
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
+  for (int p = 0; p < nprocs; p++) {
+    displs[p] = total;
+    total += counts[p];
+  }
+  std::vector<double> all(total);
+  MPI_Allgatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, world);
+  const size_t ns = total / 5;
+  std::vector<size_t> order(ns);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return all[5 * a] < all[5 * b]; });
+  sx.resize(ns);
+  sy.resize(ns);
+  sz.resize(ns);
+  sq.resize(ns);
+  stag.resize(ns);
+  for (size_t k = 0; k < ns; k++) {
+    const double *r = &all[5 * order[k]];
+    stag[k] = (tagint) r[0];
+    sx[k] = r[1];
+    sy[k] = r[2];
+    sz[k] = r[3];
+    sq[k] = r[4];
+  }
+}
+
+void CoulFMMSleepers::prepare()
+{
+  const double box[6] = {domain->boxlo[0], domain->boxlo[1], domain->xprd,
+                         domain->yprd,     domain->boxlo[2], domain->boxhi[2]};
+  const bool periodic = domain->xperiodic && domain->yperiodic;
+  bool same_box = true;
+  for (int k = 0; k < 6; k++) same_box = same_box && box[k] == built_box[k];
+  if (generation == built_generation && same_box) return;
+  gather();
+  if (periodic) {
+    field->set_box(box[0], box[1], box[2], box[3]);
+    // boundary f in z keeps every atom in the box: one far-field column for the run
+    field->set_z_range(box[4], box[5]);
+  }
+  field->set_sources(sx.size(), sx.data(), sy.data(), sz.data(), sq.data());
+  built_generation = generation;
+  std::copy(box, box + 6, built_box);
+  nrebuilds++;
+}
+
+double CoulFMMSleepers::add_field(size_t n, const double *x, const double *y, const double *z,
+                                  const double *q, size_t first, size_t last, double *pot,
+                                  double *ex, double *ey, double *ez)
+{
+  if (last <= first || sx.empty()) return 0.0;
+  const size_t m = last - first;
+  std::vector<double> r(4 * m);
+  field->evaluate(m, x + first, y + first, z + first, r.data(), r.data() + m, r.data() + 2 * m,
+                  r.data() + 3 * m);
+  double qpot = 0.0;
+  for (size_t k = 0; k < m; k++) {
+    pot[first + k] += r[k];
+    ex[first + k] += r[m + k];
+    ey[first + k] += r[2 * m + k];
+    ez[first + k] += r[3 * m + k];
+    qpot += q[first + k] * r[k];
+  }
+  (void) n;
+  return qpot;
+}
+
+double CoulFMMSleepers::source_energy()
+{
+  return sx.empty() ? 0.0 : field->source_energy();
+}
+
+double CoulFMMSleepers::memory_usage() const
+{
+  return (double) field->memory_bytes() + 5.0 * sizeof(double) * sx.size();
+}
