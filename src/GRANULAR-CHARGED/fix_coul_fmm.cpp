@@ -922,7 +922,7 @@ void FixCoulFMM::evaluate_into(double **out, int col, bool split)
   double *q = atom->q;
   size_t m = 0;
   for (int i = 0; i < nlocal; i++) {
-    if (!(mask[i] & groupbit) || q[i] == 0.0) continue;
+    if (!(mask[i] & groupbit) || q[i] == 0.0 || (split && sleepers->asleep(i))) continue;
     for (int k = 0; k < 4; k++) out[i][col + k] = c * own_result[4 * m + k];
     m++;
   }

@@ -193,7 +193,7 @@ void PairGranularOpt::compute(int eflag, int vflag)
       const double factor_lj = special_lj[sbmask(j)];
       j &= NEIGHMASK;
       if (factor_lj == 0) continue;
-      if (asleep && asleep[i] != 0.0 && asleep[j] != 0.0) continue;
+          if (asleep && asleep[i] != 0.0 && asleep[j] != 0.0) continue;
 
       const int jtype = type[j];
       const int imodel = types_indices[itype][jtype];

@@ -11,6 +11,9 @@
      wake threshold above the push nothing wakes.
    - Restart and migration: the flags survive write_restart/read_restart and atoms moving to
      another rank (displace_atoms by half the box: on 2 ranks every atom changes rank).
+   - Static sleepers in fix coul/fmm: the forces on the awake atoms and the energy, with the
+     sleeping charges as a static source at accuracy 1e-4 and 1e-6, against a full evaluation
+     of all charges at 1e-9 (sleepers full), on 1 and 2 ranks; the refused combinations.
    - Bad input: every refused keyword value, a pair style other than granular/opt, a point
      particle atom style, a fix that adds forces after it, an injection into another group.
 
@@ -26,6 +29,10 @@
 #include "pair_granular_opt.h"
 
 #include "gtest/gtest.h"
+#include "library.h"
+
+#include <cmath>
+#include <cstdio>
 
 #include <regex>
 #include <string>
@@ -79,6 +86,24 @@ LAMMPS_NS::bigint contacts(Lmp &l)
   LAMMPS_NS::bigint mine = pair ? pair->contacts_computed() : -1, all = 0;
   MPI_Allreduce(&mine, &all, 1, MPI_LMP_BIGINT, MPI_SUM, MPI_COMM_WORLD);
   return all;
+}
+
+std::vector<double> gather(Lmp &l, const char *name, int cols)
+{
+  const int n = (int) l.var("count(all)");
+  std::vector<double> v((size_t) n * cols);
+  lammps_gather_atoms(l.lmp, (char *) name, 1, cols, v.data());
+  return v;
+}
+
+double rel_rms(const std::vector<double> &f, const std::vector<double> &ref)
+{
+  double num = 0.0, den = 0.0;
+  for (size_t k = 0; k < f.size(); ++k) {
+    num += (f[k] - ref[k]) * (f[k] - ref[k]);
+    den += ref[k] * ref[k];
+  }
+  return std::sqrt(num / den);
 }
 
 std::string error_of(const std::vector<std::string> &cmds)
@@ -216,6 +241,76 @@ TEST(FixSleepGran, FlagsMigrateWithTheAtoms)
   EXPECT_EQ(contacts(l), 0);
   const auto x1 = positions(l);
   for (size_t k = 0; k < x0.size(); ++k) EXPECT_EQ(x0[k], x1[k]) << "coordinate " << k;
+}
+
+// 240 charged spheres (+-400 e) in a p p f box, apart from each other; the lower half sleeps
+// at step 1 (group low, thresholds every atom meets), the upper half moves
+void charged_spheres(Lmp &l, const std::string &coul)
+{
+  l.cmds({"units si", "atom_style hybrid sphere charge", "atom_modify map array sort 0 0",
+          "boundary p p f", "newton off", "comm_modify vel yes",
+          "region box block 0 24e-6 0 24e-6 0 48e-6", "create_box 1 box",
+          "create_atoms 1 random 240 4711 NULL overlap 2.4e-6 maxtry 500",
+          "set group all diameter 2.0e-6", "set group all density 2500",
+          "variable qq atom (2*(id%2)-1)*400*1.602176634e-19", "set group all charge v_qq",
+          "velocity all create 1e9 4711 loop geom", "region low block EDGE EDGE EDGE EDGE EDGE 24e-6",
+          "group low region low", "pair_style granular/opt", std::string("pair_coeff * * ") + MODEL,
+          "neighbor 2e-7 bin", "fix integrate all nve/sphere", "timestep 1e-9", "thermo 0", coul,
+          "fix_modify coul energy yes",
+          "fix sleep low sleep/gran speed 1e6 force 1.0 wake 10.0 time 0 every 1",
+          // step 1: every atom awake, the lower half falls asleep at its end; step 2: the same
+          // positions in every variant, evaluated with the sleepers split off (or not)
+          "thermo_style custom step pe f_sleep", "run 2"});
+}
+
+TEST(FixSleepGran, CoulombSleepersAreAStaticSource)
+{
+  Lmp ref;
+  charged_spheres(ref, "fix coul all coul/fmm accuracy 1e-9 sleepers full");
+  const double nsleep = ref.var("f_sleep[2]");
+  EXPECT_GT(nsleep, 60.0);
+  EXPECT_LT(nsleep, 180.0);
+  const auto fref = gather(ref, "f", 3);
+  const double eref = ref.var("f_coul");
+  for (double acc : {1e-4, 1e-6}) {
+    Lmp l;
+    charged_spheres(l, fmt::format("fix coul all coul/fmm accuracy {} sleepers static", acc));
+    EXPECT_EQ(l.var("f_sleep[2]"), nsleep);
+    const auto f = gather(l, "f", 3);
+    // the sleepers' forces are zero in both (fix sleep/gran); the awake atoms' forces are the
+    // requested accuracy's business: the split (Solver over the awake charges + the static
+    // field of the sleeping ones) must deliver it; the reference's own error is 1e-9
+    const double err = rel_rms(f, fref);
+    std::printf("[ static sleepers ] accuracy %g: force error %.3g, energy error %.3g\n", acc, err,
+                std::abs(l.var("f_coul") / eref - 1.0));
+    EXPECT_LT(err, acc);
+    EXPECT_GT(err, 0.0) << "two different evaluations";
+    // the energy sums pair energies (awake-awake, awake-sleeping, sleeping-sleeping); its
+    // relative error is at most the force error (potentials converge one order faster)
+    EXPECT_LT(std::abs(l.var("f_coul") / eref - 1.0), acc);
+  }
+}
+
+TEST(FixSleepGran, CoulombSleepersRefusedCombinations)
+{
+  auto err = [&](const std::string &coul, const std::string &extra = "") {
+    std::vector<std::string> c = {"units si", "atom_style hybrid sphere charge", "boundary p p f", "comm_modify vel yes",
+                                  "region box block 0 24e-6 0 24e-6 0 48e-6", "create_box 1 box",
+                                  "create_atoms 1 single 1e-5 1e-5 1e-5", "set group all charge 1e-17",
+                                  "set group all diameter 2e-6 density 2500", "neighbor 2e-7 bin",
+                                  "pair_style granular/opt", std::string("pair_coeff * * ") + MODEL,
+                                  coul, "fix sleep all sleep/gran speed 1 force 1 wake 1 time 0"};
+    if (!extra.empty()) c.push_back(extra);
+    c.push_back("run 0");
+    return error_of(c);
+  };
+  auto expect_match = [](const std::string &msg, const std::string &re) {
+    EXPECT_TRUE(std::regex_search(msg, std::regex(re))) << "message: " << msg << "\nexpected: " << re;
+  };
+  expect_match(err("fix coul all coul/fmm farfield average"), "farfield average cannot treat the sleepers");
+  EXPECT_EQ(err("fix coul all coul/fmm farfield average sleepers full"), "no error");
+  expect_match(err("fix coul all coul/fmm", "fix_modify coul virial yes"), "virial with the static sleepers");
+  expect_match(err("fix coul all coul/fmm sleepers maybe"), "sleepers must be static or full, got maybe");
 }
 
 TEST(FixSleepGran, BadInput)

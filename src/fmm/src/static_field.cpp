@@ -43,6 +43,7 @@ struct StaticSourceField::Impl {
   PeriodicFarField far;                                // exact far field: operator
   std::vector<double> phi;                             // and the sources' node potentials
   double energy = 0.0;
+  bool energy_valid = false;                           // energy of the current sources computed
 
   // targets (scratch of evaluate())
   std::vector<double> tx, ty, tz;
@@ -267,8 +268,10 @@ void StaticSourceField::set_sources(std::size_t ns, const double *x, const doubl
     s.t_source_tree = timed([&] { I.scale_sources(ns, x, y, z, q); });
     s.t_upward = timed([&] { upward_pass(I.stree, I.sq.data(), *I.ops, I.multipole); });
     I.prepare_far_field();
-    s.t_energy = timed([&] { I.compute_energy(); });
   });
+  // the sources' energy costs one Solver over them: computed when first asked
+  I.energy_valid = false;
+  s.t_energy = 0.0;
   s.sources = I.sq.size();
   s.source_nodes = I.stree.nodes.size();
   s.source_leaves = I.stree.leaves.size();
@@ -462,8 +465,13 @@ void StaticSourceField::evaluate(std::size_t nt, const double *x, const double *
 }
 
 double StaticSourceField::source_energy() const {
-  if (!impl_->sources_set) throw std::runtime_error("gcfmm: source_energy() called before set_sources()");
-  return impl_->energy;
+  Impl &I = *impl_;
+  if (!I.sources_set) throw std::runtime_error("gcfmm: source_energy() called before set_sources()");
+  if (!I.energy_valid) {
+    I.stats.t_energy = detail::timed([&] { I.compute_energy(); });
+    I.energy_valid = true;
+  }
+  return I.energy;
 }
 
 const StaticFieldStats &StaticSourceField::stats() const { return impl_->stats; }

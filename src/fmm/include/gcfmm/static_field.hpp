@@ -36,7 +36,7 @@ struct StaticFieldStats {
   double t_upward = 0.0;         //!< P2M + M2M of the sources
   double t_far_setup = 0.0;      //!< far-field operator set-up (0 when the stored one still covers)
   double t_far_prepare = 0.0;    //!< exact far field's node potentials (anterpolation + operator)
-  double t_energy = 0.0;         //!< source_energy() (one Solver build + evaluate over the sources)
+  double t_energy = 0.0;         //!< the last source_energy() that computed (one Solver over the sources)
   // evaluate()
   std::size_t targets = 0;       //!< targets of the last evaluate()
   std::size_t target_nodes = 0;  //!< nodes of the target tree
@@ -102,7 +102,7 @@ class StaticSourceField {
   /** @brief Everything that depends on the sources only: wrap and scale, the source tree, the
    *  multipoles (P2M, M2M), the exact far field's set-up (if the stored column does not cover
    *  the z range) and node potentials, the average far field's charge and bed, and
-   *  source_energy(). Sources with zero charge are dropped (sources of nothing). Cost O(ns)
+   *  nothing else (source_energy() is computed when first asked). Sources with zero charge are dropped (sources of nothing). Cost O(ns)
    *  (plus, for FarField::Exact, a set-up of ~0.5 s when the column changes).
    *  @throws CoincidentParticles (indices into these arrays) if two charged sources are closer
    *  than kCoincidenceRadius h; std::runtime_error for Periodic2D without set_box(). */
@@ -123,7 +123,10 @@ class StaticSourceField {
 
   /** @brief Energy of the sources among themselves, U_S = (1/2) sum_s q_s u_s with u as
    *  Solver::energy_potential() over the sources alone (self term dropped, images and the far
-   *  field included), computed by set_sources(). For FarField::None and Exact (pair
+   *  field included), computed on the first call after set_sources() (one Solver over the
+   *  sources: about the cost of a whole evaluation) and kept.
+   *  @throws CoincidentParticles (indices into the set_sources() arrays) if two charged
+   *  sources are closer than kCoincidenceRadius h. For FarField::None and Exact (pair
    *  energies) U_P = U_A + U_S + sum_{a in A} q_a pot^S_a for a split of P into A and S; the
    *  average far field is no pair interaction and does not split so. */
   double source_energy() const;
