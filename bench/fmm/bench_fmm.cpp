@@ -5,6 +5,7 @@
 //
 // usage: bench_fmm [--geom deposition|cube] [--n N[,N...]] [--acc a[,a...]] [--order p[,p...]]
 //                  [--theta t[,t...]] [--leaf L] [--images k] [--reps r] [--sample s]
+#include "bench_util.hpp"
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -59,19 +60,7 @@ Particles cube(std::size_t n, unsigned seed) {
   return p;
 }
 
-template <class T>
-std::vector<T> list(const char *s) {
-  std::vector<T> v;
-  std::string str(s);
-  std::size_t a = 0;
-  while (a <= str.size()) {
-    std::size_t b = str.find(',', a);
-    if (b == std::string::npos) b = str.size();
-    v.push_back(static_cast<T>(std::atof(str.substr(a, b - a).c_str())));
-    a = b + 1;
-  }
-  return v;
-}
+using gcfmm_bench::list;
 
 }  // namespace
 

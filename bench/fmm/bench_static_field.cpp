@@ -11,6 +11,7 @@
 //                           [--tleaf L[,L...]] [--reps r] [--check 0|1]
 // --check 1 also measures the error of Solver(targets) + StaticSourceField(sources) against the
 // whole Solver at the targets (relative RMS of the field).
+#include "bench_util.hpp"
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -38,19 +39,7 @@ struct Particles {
   }
 };
 
-template <class T>
-std::vector<T> list(const char *s) {
-  std::vector<T> v;
-  std::string str(s);
-  std::size_t a = 0;
-  while (a <= str.size()) {
-    std::size_t b = str.find(',', a);
-    if (b == std::string::npos) b = str.size();
-    v.push_back(static_cast<T>(std::atof(str.substr(a, b - a).c_str())));
-    a = b + 1;
-  }
-  return v;
-}
+using gcfmm_bench::list;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

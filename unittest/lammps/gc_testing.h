@@ -4,8 +4,10 @@
 #define GC_TESTING_H
 
 #include "atom.h"
+#include "exceptions.h"
 #include "input.h"
 #include "lammps.h"
+#include "library.h"
 #include "variable.h"
 
 #include <cmath>
@@ -81,6 +83,38 @@ inline std::vector<double> lmp_process(const std::string &lmp, const std::vector
   std::remove(input.c_str());
   std::remove(dump.c_str());
   return s;
+}
+
+// the message of the LAMMPS error that `cmds` raise in a fresh instance, or "no error"
+inline std::string error_of(const std::vector<std::string> &cmds)
+{
+  Lmp l;
+  try {
+    l.cmds(cmds);
+  } catch (LAMMPS_NS::LAMMPSException &e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+// per-atom property `name` (cols values each) of all atoms, ordered by atom ID
+inline std::vector<double> gather(Lmp &l, const char *name, int cols)
+{
+  const int n = (int) l.var("count(all)");
+  std::vector<double> v((size_t) n * cols);
+  lammps_gather_atoms(l.lmp, (char *) name, 1, cols, v.data());
+  return v;
+}
+
+// relative RMS difference |f - ref| / |ref| over all components
+inline double rel_rms(const std::vector<double> &f, const std::vector<double> &ref)
+{
+  double num = 0.0, den = 0.0;
+  for (size_t k = 0; k < f.size(); ++k) {
+    num += (f[k] - ref[k]) * (f[k] - ref[k]);
+    den += ref[k] * ref[k];
+  }
+  return std::sqrt(num / den);
 }
 
 // ---- JKR closed forms (doc/theory.md, eqs. (1.2)-(1.4)), independent of LAMMPS's implementation ----------

@@ -15,26 +15,11 @@
 #include <vector>
 
 using gctest::Lmp;
+using gctest::rel_rms;
+using gctest::gather;
+using gctest::error_of;
 
 namespace {
-
-std::vector<double> gather(Lmp &l, const char *name, int cols)
-{
-  const int n = (int) l.var("count(all)");
-  std::vector<double> v((size_t) n * cols);
-  lammps_gather_atoms(l.lmp, (char *) name, 1, cols, v.data());
-  return v;
-}
-
-double rel_rms(const std::vector<double> &f, const std::vector<double> &ref)
-{
-  double num = 0.0, den = 0.0;
-  for (size_t k = 0; k < f.size(); ++k) {
-    num += (f[k] - ref[k]) * (f[k] - ref[k]);
-    den += ref[k] * ref[k];
-  }
-  return std::sqrt(num / den);
-}
 
 // n random charges of both signs (alternating, so the system is neutral for even n) in a box
 void random_charges(Lmp &l, const std::string &boundary, int n, double lx, double lz, int seed)
@@ -45,17 +30,6 @@ void random_charges(Lmp &l, const std::string &boundary, int n, double lx, doubl
           fmt::format("create_atoms 1 random {} {} NULL overlap 0.5 maxtry 200", n, seed),
           "mass 1 1.0", "variable qq atom 2*(id%2)-1", "set group all charge v_qq",
           "neighbor 1.0 bin", "thermo_style custom step pe", "thermo_modify norm no"});
-}
-
-std::string error_of(const std::vector<std::string> &cmds)
-{
-  Lmp l;
-  try {
-    l.cmds(cmds);
-  } catch (LAMMPS_NS::LAMMPSException &e) {
-    return e.what();
-  }
-  return "no error";
 }
 
 int nprocs()

@@ -15,6 +15,7 @@
 
 using gctest::JKR;
 using gctest::Lmp;
+using gctest::error_of;
 
 namespace {
 
@@ -49,17 +50,6 @@ double force_at(Lmp &l, double delta)
   l.cmd(fmt::format("set atom 2 x {:.17g}", 2 * RP - delta));
   l.cmd("run 0 post no");
   return -l.var("fx[1]");    // > 0 repulsive: force on atom 1 points to -x
-}
-
-std::string error_of(const std::vector<std::string> &cmds)
-{
-  Lmp l;
-  try {
-    l.cmds(cmds);
-  } catch (LAMMPS_NS::LAMMPSException &e) {
-    return e.what();
-  }
-  return "no error";
 }
 
 }    // namespace

@@ -19,6 +19,7 @@
 
 using gctest::JKR;
 using gctest::Lmp;
+using gctest::error_of;
 
 namespace {
 
@@ -71,17 +72,6 @@ std::vector<double> cperatom(Lmp &l, const std::string &id, MPI_Comm comm)
     for (int i = 0; i < l.lmp->atom->nlocal; i++) loc[l.lmp->atom->tag[i]] = p[i];
   MPI_Allreduce(loc.data(), all.data(), natoms + 1, MPI_DOUBLE, MPI_SUM, comm);
   return all;
-}
-
-std::string error_of(const std::vector<std::string> &cmds)
-{
-  Lmp l;
-  try {
-    l.cmds(cmds);
-  } catch (LAMMPS_NS::LAMMPSException &e) {
-    return e.what();
-  }
-  return "no error";
 }
 
 void expect_match(const std::string &msg, const std::string &re)

@@ -39,6 +39,9 @@
 #include <vector>
 
 using gctest::Lmp;
+using gctest::rel_rms;
+using gctest::gather;
+using gctest::error_of;
 
 namespace {
 const char *MODEL = "jkr/marshall 2e8 0.7 0.33 0.01 damping marshall tangential marshall 0.3 "
@@ -88,34 +91,6 @@ LAMMPS_NS::bigint contacts(Lmp &l)
   return all;
 }
 
-std::vector<double> gather(Lmp &l, const char *name, int cols)
-{
-  const int n = (int) l.var("count(all)");
-  std::vector<double> v((size_t) n * cols);
-  lammps_gather_atoms(l.lmp, (char *) name, 1, cols, v.data());
-  return v;
-}
-
-double rel_rms(const std::vector<double> &f, const std::vector<double> &ref)
-{
-  double num = 0.0, den = 0.0;
-  for (size_t k = 0; k < f.size(); ++k) {
-    num += (f[k] - ref[k]) * (f[k] - ref[k]);
-    den += ref[k] * ref[k];
-  }
-  return std::sqrt(num / den);
-}
-
-std::string error_of(const std::vector<std::string> &cmds)
-{
-  Lmp l;
-  try {
-    l.cmds(cmds);
-  } catch (LAMMPS_NS::LAMMPSException &e) {
-    return e.what();
-  }
-  return "no error";
-}
 }    // namespace
 
 // thresholds that every atom meets at once (time 0, commit every step): all sleep after run 1
