@@ -41,7 +41,7 @@ enum RestartSlot { R_SLEEP_EVENTS, R_WAKE_EVENTS, R_NSLOTS };
 FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), speed_sleep(-1.0), force_sleep(-1.0), force_wake(-1.0), rest_time(-1.0),
     depth(0.0), every(100), rest_steps_needed(0), asleep(nullptr),
-    rest_steps(nullptr), push(nullptr), wake_mark(nullptr), comm_mode(COMM_FLAGS),
+    rest_steps(nullptr), push(nullptr), wake_mark(nullptr), ncontact(nullptr), comm_mode(COMM_FLAGS),
     set_generation(0), nsleeping_all(0), nsleep_events(0), nwake_events(0), pair_checked(0)
 {
   if (!(atom->radius_flag && atom->rmass_flag && atom->omega_flag && atom->torque_flag))
@@ -96,13 +96,13 @@ FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
   restart_peratom = 1;
   restart_global = 1;
   comm_forward = 1;
-  comm_reverse = 3;
+  comm_reverse = 4;
 
   FixSleepGran::grow_arrays(atom->nmax);
   atom->add_callback(Atom::GROW);
   atom->add_callback(Atom::RESTART);
   for (int i = 0; i < atom->nmax; i++) {
-    asleep[i] = rest_steps[i] = wake_mark[i] = 0.0;
+    asleep[i] = rest_steps[i] = wake_mark[i] = ncontact[i] = 0.0;
     push[i][0] = push[i][1] = push[i][2] = 0.0;
   }
 }
@@ -118,6 +118,7 @@ FixSleepGran::~FixSleepGran()
   memory->destroy(rest_steps);
   memory->destroy(push);
   memory->destroy(wake_mark);
+  memory->destroy(ncontact);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -177,7 +178,10 @@ void FixSleepGran::setup_pre_force(int /*vflag*/)
 {
   exchange_flags();
   const int nall = atom->nlocal + atom->nghost;
-  for (int i = 0; i < nall; i++) push[i][0] = push[i][1] = push[i][2] = 0.0;
+  for (int i = 0; i < nall; i++) {
+    push[i][0] = push[i][1] = push[i][2] = 0.0;
+    ncontact[i] = 0.0;
+  }
 }
 
 /* ---------------------------------------------------------------------- */
@@ -196,7 +200,10 @@ void FixSleepGran::pre_force(int /*vflag*/)
 {
   if (neighbor->ago == 0) exchange_flags();
   const int nall = atom->nlocal + atom->nghost;
-  for (int i = 0; i < nall; i++) push[i][0] = push[i][1] = push[i][2] = 0.0;
+  for (int i = 0; i < nall; i++) {
+    push[i][0] = push[i][1] = push[i][2] = 0.0;
+    ncontact[i] = 0.0;
+  }
 }
 
 /* ---------------------------------------------------------------------- */
@@ -213,7 +220,7 @@ void FixSleepGran::post_force(int /*vflag*/)
 {
   if (force->newton_pair) {
     comm_mode = COMM_PUSH;
-    comm->reverse_comm(this, 3);
+    comm->reverse_comm(this, 4);
   }
   const int nlocal = atom->nlocal;
   int changed = 0;
@@ -224,7 +231,7 @@ void FixSleepGran::post_force(int /*vflag*/)
   int *mask = atom->mask;
   for (int i = 0; i < nlocal; i++) {
     if (asleep[i] != 0.0 || wake_mark[i] != 0.0) continue;
-    if ((mask[i] & groupbit) && at_rest(i))
+    if ((mask[i] & groupbit) && ncontact[i] > 0.0 && at_rest(i))
       rest_steps[i] += 1.0;
     else
       rest_steps[i] = 0.0;
@@ -307,7 +314,8 @@ void FixSleepGran::wake_pushed()
 
 /* ----------------------------------------------------------------------
    commit to sleep the atoms at rest for the rest time, and (keyword depth) those slower than
-   10 x speed lying at least `depth` below the top of the bed in their column
+   10 x speed lying at least `depth` below the top of the bed in their column; either way only
+   atoms that touch another (a contact the pair style computed this step)
 ------------------------------------------------------------------------- */
 
 void FixSleepGran::fall_asleep()
@@ -326,7 +334,8 @@ void FixSleepGran::fall_asleep()
   for (int i = 0; i < nlocal; i++) {
     if (asleep[i] != 0.0 || !(mask[i] & groupbit)) continue;
     bool sleep = rest_steps[i] >= rest_steps_needed && rest_steps[i] >= 1.0;
-    if (!sleep && depth > 0.0 && v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2] < vdeep2) {
+    if (!sleep && depth > 0.0 && ncontact[i] > 0.0 &&
+        v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2] < vdeep2) {
       int bx = static_cast<int>((x[i][0] - domain->boxlo[0]) / domain->xprd * nbx);
       int by = static_cast<int>((x[i][1] - domain->boxlo[1]) / domain->yprd * nby);
       bx = MIN(MAX(bx, 0), nbx - 1);
@@ -361,8 +370,11 @@ void FixSleepGran::surface_heights(std::vector<double> &top, int &nbx, int &nby)
   double **x = atom->x, **v = atom->v;
   const double vbed2 = 100.0 * speed_sleep * speed_sleep;
   for (int i = 0; i < atom->nlocal; i++) {
-    // the bed: sleepers and atoms slower than 10 x speed (not those falling onto it)
-    if (asleep[i] == 0.0 && v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2] >= vbed2) continue;
+    // the bed: sleepers and the atoms in contact slower than 10 x speed (not those falling
+    // onto it, nor slow ones hovering above a charged bed)
+    if (asleep[i] == 0.0 &&
+        (ncontact[i] == 0.0 || v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2] >= vbed2))
+      continue;
     int bx = static_cast<int>((x[i][0] - domain->boxlo[0]) / domain->xprd * nbx);
     int by = static_cast<int>((x[i][1] - domain->boxlo[1]) / domain->yprd * nby);
     bx = MIN(MAX(bx, 0), nbx - 1);
@@ -423,7 +435,7 @@ double FixSleepGran::compute_vector(int n)
 
 double FixSleepGran::memory_usage()
 {
-  return static_cast<double>(atom->nmax) * 6 * sizeof(double);
+  return static_cast<double>(atom->nmax) * 7 * sizeof(double);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -434,6 +446,7 @@ void FixSleepGran::grow_arrays(int nmax)
   memory->grow(rest_steps, nmax, "sleep/gran:rest_steps");
   memory->grow(push, nmax, 3, "sleep/gran:push");
   memory->grow(wake_mark, nmax, "sleep/gran:wake_mark");
+  memory->grow(ncontact, nmax, "sleep/gran:ncontact");
   vector_atom = asleep;
 }
 
@@ -483,6 +496,7 @@ int FixSleepGran::pack_reverse_comm(int n, int first, double *buf)
       buf[m++] = push[i][0];
       buf[m++] = push[i][1];
       buf[m++] = push[i][2];
+      buf[m++] = ncontact[i];
     } else {
       buf[m++] = wake_mark[i];
     }
@@ -499,6 +513,7 @@ void FixSleepGran::unpack_reverse_comm(int n, int *list, double *buf)
       push[j][0] += buf[m++];
       push[j][1] += buf[m++];
       push[j][2] += buf[m++];
+      ncontact[j] += buf[m++];
     } else {
       wake_mark[j] = MAX(wake_mark[j], buf[m++]);
     }

@@ -68,6 +68,9 @@ class FixSleepGran : public Fix {
   // per atom (local and ghost): contact force on a sleeper from its awake partners, summed
   // by the pair style into this array (zeroed in pre_force)
   double **awake_push() { return push; }
+  // per atom (local and ghost): contacts the pair style computed this step (zeroed in
+  // pre_force); only an atom that touches another can fall asleep
+  double *contact_count() { return ncontact; }
   bigint sleeping_count() const { return nsleeping_all; }
 
  private:
@@ -78,6 +81,7 @@ class FixSleepGran : public Fix {
   double *rest_steps;    // consecutive steps at rest (local)
   double **push;         // force from awake contact partners (local + ghost)
   double *wake_mark;     // reverse-communicated wake requests (local + ghost)
+  double *ncontact;      // computed contacts this step (local + ghost)
   int comm_mode;         // what pack_forward_comm / pack_reverse_comm move
 
   bigint set_generation;

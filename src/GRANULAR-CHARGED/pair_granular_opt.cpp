@@ -175,6 +175,7 @@ void PairGranularOpt::compute(int eflag, int vflag)
   // with an awake atom is also summed into the fix's push array (its wake test)
   const double *asleep = sleep_fix ? sleep_fix->sleeping() : nullptr;
   double **push = sleep_fix ? sleep_fix->awake_push() : nullptr;
+  double *ncontact = sleep_fix ? sleep_fix->contact_count() : nullptr;
   if (asleep) update_active(asleep);
   const int nactive = asleep ? static_cast<int>(active.size()) : inum;
   bigint contacts = 0;
@@ -360,6 +361,8 @@ void PairGranularOpt::compute(int eflag, int vflag)
         ev_tally_xyz(i, j, nlocal, newton_pair, 0.0, 0.0, forces[0], forces[1], forces[2], dx[0],
                      dx[1], dx[2]);
       if (asleep) {
+        ncontact[i] += 1.0;
+        if (newton_pair || j < nlocal) ncontact[j] += 1.0;
         if (asleep[i] != 0.0) add3(push[i], forces, push[i]);
         if (asleep[j] != 0.0 && (newton_pair || j < nlocal)) sub3(push[j], forces, push[j]);
       }

@@ -124,13 +124,15 @@ TEST(FixSleepGran, HeldAndSkipped)
   EXPECT_NE(fsum0, 0.0);
 }
 
-// sphere 1 sleeps (the only member of the fix group), sphere 2 hits it at 0.3 m/s
+// sphere 1 and sphere 3 below it, touching (an atom sleeps only in contact), sleep (the fix
+// group); sphere 2 hits sphere 1 at 0.3 m/s
 std::vector<std::string> impact(const std::string &hold)
 {
   return {"units si", "atom_style sphere", "atom_modify map array", "boundary f f f",
           "newton off", "comm_modify vel yes", "region box block -1e-5 1e-5 -1e-5 1e-5 -1e-5 1e-5",
           "create_box 1 box", "create_atoms 1 single 0 0 0", "create_atoms 1 single 0.8e-6 0.3e-6 2.1e-6",
-          "set group all diameter 2.0e-6", "set group all density 2500", "group one id 1",
+          "create_atoms 1 single 0 0 -1.999e-6",
+          "set group all diameter 2.0e-6", "set group all density 2500", "group one id 1 3",
           "group two id 2", "pair_style granular/opt", std::string("pair_coeff * * ") + MODEL,
           "neighbor 2e-7 bin", "neigh_modify every 1 delay 0 check yes",
           "velocity two set 0.01 -0.02 -0.3", "set atom 2 omega 1e4 -2e4 3e3",
@@ -142,16 +144,19 @@ TEST(FixSleepGran, SleeperIsAFixedBody)
   if (nprocs() > 1) GTEST_SKIP() << "single-rank test";
   Lmp a, b;
   a.cmds(impact("fix sleep one sleep/gran speed 1e3 force 1.0 wake 1e3 time 0 every 1"));
-  b.cmds(impact("fix hold one freeze"));
+  // step 1 moves spheres 1 and 3 (their contact snaps) until they fall asleep at its end, with
+  // zero velocity: the reference takes the same step free, then holds them by fix freeze
+  b.cmds(impact("thermo 0"));
   a.cmd("run 1");
-  b.cmd("run 1");
-  EXPECT_EQ(a.var("f_sleep[2]"), 1.0);
+  b.cmds({"run 1", "velocity one set 0 0 0", "set group one omega 0 0 0", "fix hold one freeze"});
+  EXPECT_EQ(a.var("f_sleep[2]"), 2.0);
+  EXPECT_EQ(a.var("z[1]"), b.var("z[1]"));
   a.cmd("run 3000");
   b.cmd("run 3000");
   EXPECT_GT(a.var("f_sleep[3]"), 0.0);
   const char *q[] = {"x[2]", "y[2]", "z[2]", "vx[2]", "vy[2]", "vz[2]"};
   for (auto *e : q) EXPECT_EQ(a.var(e), b.var(e)) << e;
-  EXPECT_EQ(a.var("x[1]"), 0.0);
+  EXPECT_EQ(a.var("z[1]"), b.var("z[1]")) << "the sleeper did not move";
   // the impact happened: the sphere stuck to the sleeper or rebounded
   EXPECT_GT(std::abs(b.var("vz[2]") + 0.3), 0.01);
 }
@@ -160,8 +165,7 @@ TEST(FixSleepGran, WakesWhenPushed)
 {
   if (nprocs() > 1) GTEST_SKIP() << "single-rank test";
   // sphere 3 below sphere 1, touching it: both sleep; sphere 2 hits 1
-  auto cmds = impact("create_atoms 1 single 0 0 -1.999e-6");
-  cmds.insert(cmds.end(), {"set atom 3 diameter 2.0e-6 density 2500", "group bedg id 1 3"});
+  auto cmds = impact("group bedg id 1 3");
   {
     Lmp l;
     l.cmds(cmds);
@@ -218,22 +222,28 @@ TEST(FixSleepGran, FlagsMigrateWithTheAtoms)
   for (size_t k = 0; k < x0.size(); ++k) EXPECT_EQ(x0[k], x1[k]) << "coordinate " << k;
 }
 
-// 240 charged spheres (+-400 e) in a p p f box, apart from each other; the lower half sleeps
-// at step 1 (group low, thresholds every atom meets), the upper half moves
+// charged spheres (+-400 e) in a p p f box: a touching layer of 144 below with random signs,
+// which sleeps at step 1 (group low, thresholds every atom meets; an atom sleeps only in
+// contact), and 240 of alternating sign apart from each other above it, which move
 void charged_spheres(Lmp &l, const std::string &coul)
 {
   l.cmds({"units si", "atom_style hybrid sphere charge", "atom_modify map array sort 0 0",
           "boundary p p f", "newton off", "comm_modify vel yes",
           "region box block 0 24e-6 0 24e-6 0 48e-6", "create_box 1 box",
-          "create_atoms 1 random 240 4711 NULL overlap 2.4e-6 maxtry 500",
+          "lattice sc 1.995e-6", "region bed block 0 11.5 0 11.5 0.5 1.5", "create_atoms 1 region bed",
+          "region above block EDGE EDGE EDGE EDGE 8e-6 46e-6 units box",
+          "create_atoms 1 random 240 4711 above overlap 2.4e-6 maxtry 500",
           "set group all diameter 2.0e-6", "set group all density 2500",
           "variable qq atom (2*(id%2)-1)*400*1.602176634e-19", "set group all charge v_qq",
-          "velocity all create 1e9 4711 loop geom", "region low block EDGE EDGE EDGE EDGE EDGE 24e-6",
-          "group low region low", "pair_style granular/opt", std::string("pair_coeff * * ") + MODEL,
-          "neighbor 2e-7 bin", "fix integrate all nve/sphere", "timestep 1e-9", "thermo 0", coul,
+          "group bedatoms region bed",
+          "variable qb atom (2*(random(0,1,777)>0.5)-1)*400*1.602176634e-19",
+          "set group bedatoms charge v_qb", "velocity all create 1e9 4711 loop geom",
+          "region low block EDGE EDGE EDGE EDGE EDGE 4e-6 units box", "group low region low",
+          "pair_style granular/opt", std::string("pair_coeff * * ") + MODEL, "neighbor 2e-7 bin",
+          "fix integrate all nve/sphere", "timestep 1e-9", "thermo 0", coul,
           "fix_modify coul energy yes",
           "fix sleep low sleep/gran speed 1e6 force 1.0 wake 10.0 time 0 every 1",
-          // step 1: every atom awake, the lower half falls asleep at its end; step 2: the same
+          // step 1: every atom awake, the layer falls asleep at its end; step 2: the same
           // positions in every variant, evaluated with the sleepers split off (or not)
           "thermo_style custom step pe f_sleep", "run 2"});
 }
@@ -243,8 +253,7 @@ TEST(FixSleepGran, CoulombSleepersAreAStaticSource)
   Lmp ref;
   charged_spheres(ref, "fix coul all coul/fmm accuracy 1e-9 sleepers full");
   const double nsleep = ref.var("f_sleep[2]");
-  EXPECT_GT(nsleep, 60.0);
-  EXPECT_LT(nsleep, 180.0);
+  EXPECT_EQ(nsleep, 144.0);
   const auto fref = gather(ref, "f", 3);
   const double eref = ref.var("f_coul");
   for (double acc : {1e-4, 1e-6}) {
@@ -252,9 +261,13 @@ TEST(FixSleepGran, CoulombSleepersAreAStaticSource)
     charged_spheres(l, fmt::format("fix coul all coul/fmm accuracy {} sleepers static", acc));
     EXPECT_EQ(l.var("f_sleep[2]"), nsleep);
     const auto f = gather(l, "f", 3);
-    // the sleepers' forces are zero in both (fix sleep/gran); the awake atoms' forces are the
-    // requested accuracy's business: the split (Solver over the awake charges + the static
-    // field of the sleeping ones) must deliver it; the reference's own error is 1e-9
+    // the sleepers' forces are zero in both (fix sleep/gran). The awake atoms' forces must meet
+    // the requested accuracy (the split: Solver over the awake charges + the static field of the
+    // sleeping ones; the reference's own error is 1e-9). Measured ~1e-11: in this sparse set the
+    // nearest pairs, summed directly, dominate every force, so the test guards the split's
+    // bookkeeping (the sleepers' field at the right atoms: 0.96 when it was not, 0.96 without
+    // the static field); its accuracy with multipole translations is fmm.static_field's
+    // (SplitPlusStaticEqualsWholeSolver) and the deposition's check (doc/fix_coul_fmm.md)
     const double err = rel_rms(f, fref);
     std::printf("[ static sleepers ] accuracy %g: force error %.3g, energy error %.3g\n", acc, err,
                 std::abs(l.var("f_coul") / eref - 1.0));
