@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # CPU of the deposition deck against N at a fixed floor area, sleeping off and on, the two runs
 # of each N started together (one per core, so both see the same machine).
-#   bench/sleep/growth.sh [build-dir] [-var NAME VALUE ...]      (env NS="250 1000", L_RP=10)
+#   bench/sleep/growth.sh [build-dir] [-var NAME VALUE ...]      (env NS="250 1000", L_RP=10,
+#   DECK=another deck)
 # Prints per N: user CPU, steps, CPU per step of each setting, and CPU(N) / CPU(N_first) of each.
 # With sleeping on, also the cost per step against the number of awake atoms, from the thermo
 # lines (CPU and f_sleep columns) of the largest N.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
-deck=$here/../../python/granular_charged/decks/in.deposition
+deck=${DECK:-$here/../../python/granular_charged/decks/in.deposition}
 build=$(cd "${1:-$here/../../build}" && pwd); shift || true
 vars=("$@")
 ns=(${NS:-250 1000}); L=${L_RP:-10}
