@@ -40,7 +40,7 @@ enum RestartSlot { R_SLEEP_EVENTS, R_WAKE_EVENTS, R_NSLOTS };
 
 FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), speed_sleep(-1.0), force_sleep(-1.0), force_wake(-1.0), rest_time(-1.0),
-    depth(0.0), every(100), rest_steps_needed(0), asleep(nullptr),
+    depth(0.0), every(100), rest_steps_needed(0), rest_rule(true), asleep(nullptr),
     rest_steps(nullptr), push(nullptr), wake_mark(nullptr), ncontact(nullptr), comm_mode(COMM_FLAGS),
     set_generation(0), nsleeping_all(0), nsleep_events(0), nwake_events(0), pair_checked(0)
 {
@@ -65,9 +65,14 @@ FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
       force_wake = positive("wake");
     } else if (strcmp(arg[iarg], "time") == 0) {
       if (iarg + 2 > narg) utils::missing_cmd_args(FLERR, "fix sleep/gran time", error);
-      rest_time = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
-      if (!(rest_time >= 0.0) || !std::isfinite(rest_time))
-        error->all(FLERR, "Fix {} time must be >= 0, got {}", style, arg[iarg + 1]);
+      if (strcmp(arg[iarg + 1], "none") == 0) {
+        rest_rule = false;    // only the depth rule puts atoms to sleep
+        rest_time = 0.0;
+      } else {
+        rest_time = utils::numeric(FLERR, arg[iarg + 1], false, lmp);
+        if (!(rest_time >= 0.0) || !std::isfinite(rest_time))
+          error->all(FLERR, "Fix {} time must be >= 0 or none, got {}", style, arg[iarg + 1]);
+      }
       iarg += 2;
     } else if (strcmp(arg[iarg], "every") == 0) {
       if (iarg + 2 > narg) utils::missing_cmd_args(FLERR, "fix sleep/gran every", error);
@@ -82,6 +87,8 @@ FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
   }
   if (speed_sleep < 0.0 || force_sleep < 0.0 || force_wake < 0.0 || rest_time < 0.0)
     error->all(FLERR, "Fix {} needs the keywords speed, force, wake and time", style);
+  if (!rest_rule && depth <= 0.0)
+    error->all(FLERR, "Fix {} time none needs keyword depth (nothing would fall asleep)", style);
 
   scalar_flag = 1;
   vector_flag = 1;
@@ -333,7 +340,7 @@ void FixSleepGran::fall_asleep()
   bigint n = 0;
   for (int i = 0; i < nlocal; i++) {
     if (asleep[i] != 0.0 || !(mask[i] & groupbit)) continue;
-    bool sleep = rest_steps[i] >= rest_steps_needed && rest_steps[i] >= 1.0;
+    bool sleep = rest_rule && rest_steps[i] >= rest_steps_needed && rest_steps[i] >= 1.0;
     if (!sleep && depth > 0.0 && ncontact[i] > 0.0 &&
         v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2] < vdeep2) {
       int bx = static_cast<int>((x[i][0] - domain->boxlo[0]) / domain->xprd * nbx);

@@ -76,6 +76,7 @@ class FixSleepGran : public Fix {
  private:
   double speed_sleep, force_sleep, force_wake, rest_time, depth;
   int every, rest_steps_needed;
+  bool rest_rule;    // time none: only the depth rule
 
   double *asleep;        // 1.0 sleeping, 0.0 awake (local + ghost)
   double *rest_steps;    // consecutive steps at rest (local)

@@ -319,7 +319,9 @@ TEST(FixSleepGran, BadInput)
   expect_match(err("fix s all sleep/gran speed 0 force 1e-8 wake 1e-7 time 1e-6"), "sleep/gran speed must be > 0, got 0");
   expect_match(err("fix s all sleep/gran speed 1e-3 force -1 wake 1e-7 time 1e-6"), "force must be > 0, got -1");
   expect_match(err("fix s all sleep/gran speed 1e-3 force 1e-8 wake nan time 1e-6"), "wake must be > 0|Expected floating");
-  expect_match(err("fix s all sleep/gran speed 1e-3 force 1e-8 wake 1e-7 time -1"), "time must be >= 0, got -1");
+  expect_match(err("fix s all sleep/gran speed 1e-3 force 1e-8 wake 1e-7 time -1"), "time must be >= 0 or none, got -1");
+  expect_match(err("fix s all sleep/gran speed 1e-3 force 1e-8 wake 1e-7 time none"), "time none needs keyword depth");
+  EXPECT_EQ(err("fix s all sleep/gran speed 1e-3 force 1e-8 wake 1e-7 time none depth 1e-5"), "no error");
   expect_match(err(ok + " every 0"), "every must be >= 1, got 0");
   expect_match(err(ok + " depth -2e-6"), "depth must be > 0, got -2e-6");
   expect_match(err(ok + " bogus 1"), "Unknown fix sleep/gran keyword bogus");
