@@ -110,7 +110,7 @@ void CoulFMMSleepers::prepare()
   nrebuilds++;
 }
 
-double CoulFMMSleepers::add_field(size_t n, const double *x, const double *y, const double *z,
+double CoulFMMSleepers::add_field(const double *x, const double *y, const double *z,
                                   const double *q, size_t first, size_t last, double *pot,
                                   double *ex, double *ey, double *ez)
 {
@@ -127,7 +127,6 @@ double CoulFMMSleepers::add_field(size_t n, const double *x, const double *y, co
     ez[first + k] += r[3 * m + k];
     qpot += q[first + k] * r[k];
   }
-  (void) n;
   return qpot;
 }
 

@@ -42,8 +42,8 @@ class CoulFMMSleepers : protected Pointers {
   // what gcfmm throws
   void prepare();
   // ADD the sleepers' potential and field (bare 1/r kernel) at the targets [first, last) of
-  // the n gathered awake atoms; returns sum_t q_t pot_t over those targets
-  double add_field(size_t n, const double *x, const double *y, const double *z, const double *q,
+  // the gathered awake atoms; returns sum_t q_t pot_t over those targets
+  double add_field(const double *x, const double *y, const double *z, const double *q,
                    size_t first, size_t last, double *pot, double *ex, double *ey, double *ez);
   // energy of the sleepers among themselves (bare kernel), computed when first asked after a
   // change of the set

@@ -806,7 +806,7 @@ void FixCoulFMM::add_sleepers_field(size_t n, double *pot, double *ex, double *e
 {
   const size_t first = n * comm->me / comm->nprocs, last = n * (comm->me + 1) / comm->nprocs;
   try {
-    sleeper_qpot_local = sleepers->add_field(n, gx.data(), gy.data(), gz.data(), gq.data(), first,
+    sleeper_qpot_local = sleepers->add_field(gx.data(), gy.data(), gz.data(), gq.data(), first,
                                              last, pot, ex, ey, ez);
   } catch (gcfmm::CoincidentParticles &e) {
     throw SleeperCoincidence{fmt::format(

@@ -244,12 +244,11 @@ void FixSleepGran::post_force(int /*vflag*/)
       rest_steps[i] = 0.0;
   }
 
+  // falling asleep happens only on commit steps (fall_asleep() sums its count over the ranks)
   const bigint before = nsleep_events;
   if (update->ntimestep % every == 0) fall_asleep();
   changed = nsleep_events != before;
-  int any = 0;
-  MPI_Allreduce(&changed, &any, 1, MPI_INT, MPI_MAX, world);
-  if (any) {
+  if (changed) {
     exchange_flags();
     set_generation++;
     count_sleeping();
@@ -343,11 +342,7 @@ void FixSleepGran::fall_asleep()
     bool sleep = rest_rule && rest_steps[i] >= rest_steps_needed && rest_steps[i] >= 1.0;
     if (!sleep && depth > 0.0 && ncontact[i] > 0.0 &&
         v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2] < vdeep2) {
-      int bx = static_cast<int>((x[i][0] - domain->boxlo[0]) / domain->xprd * nbx);
-      int by = static_cast<int>((x[i][1] - domain->boxlo[1]) / domain->yprd * nby);
-      bx = MIN(MAX(bx, 0), nbx - 1);
-      by = MIN(MAX(by, 0), nby - 1);
-      sleep = top[by * nbx + bx] - x[i][2] >= depth;
+      sleep = top[column_of(x[i], nbx, nby)] - x[i][2] >= depth;
     }
     if (!sleep) continue;
     asleep[i] = 1.0;
@@ -356,6 +351,19 @@ void FixSleepGran::fall_asleep()
   bigint all = 0;
   MPI_Allreduce(&n, &all, 1, MPI_LMP_BIGINT, MPI_SUM, world);
   nsleep_events += all;
+}
+
+/* ----------------------------------------------------------------------
+   index of the column (of nbx x nby over the box in x, y) holding position x
+------------------------------------------------------------------------- */
+
+int FixSleepGran::column_of(const double *x, int nbx, int nby) const
+{
+  int bx = static_cast<int>((x[0] - domain->boxlo[0]) / domain->xprd * nbx);
+  int by = static_cast<int>((x[1] - domain->boxlo[1]) / domain->yprd * nby);
+  bx = MIN(MAX(bx, 0), nbx - 1);
+  by = MIN(MAX(by, 0), nby - 1);
+  return by * nbx + bx;
 }
 
 /* ----------------------------------------------------------------------
@@ -382,11 +390,7 @@ void FixSleepGran::surface_heights(std::vector<double> &top, int &nbx, int &nby)
     if (asleep[i] == 0.0 &&
         (ncontact[i] == 0.0 || v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2] >= vbed2))
       continue;
-    int bx = static_cast<int>((x[i][0] - domain->boxlo[0]) / domain->xprd * nbx);
-    int by = static_cast<int>((x[i][1] - domain->boxlo[1]) / domain->yprd * nby);
-    bx = MIN(MAX(bx, 0), nbx - 1);
-    by = MIN(MAX(by, 0), nby - 1);
-    double &t = mine[by * nbx + bx];
+    double &t = mine[column_of(x[i], nbx, nby)];
     t = MAX(t, x[i][2] + atom->radius[i]);
   }
   MPI_Allreduce(mine.data(), top.data(), (int) mine.size(), MPI_DOUBLE, MPI_MAX, world);

@@ -95,6 +95,7 @@ class FixSleepGran : public Fix {
   void wake_pushed();
   void hold_sleepers();
   void surface_heights(std::vector<double> &top, int &nbx, int &nby) const;
+  int column_of(const double *x, int nbx, int nby) const;
   void count_sleeping();
   void check_fix_order();
 };
