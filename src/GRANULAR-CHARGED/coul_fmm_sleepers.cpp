@@ -9,6 +9,8 @@
 
 #include "coul_fmm_sleepers.h"
 
+#include "coul_fmm_comm.h"
+
 #include "atom.h"
 #include "comm.h"
 #include "domain.h"
@@ -17,7 +19,6 @@
 #include "gcfmm/static_field.hpp"
 
 #include <algorithm>
-#include <numeric>
 
 using namespace LAMMPS_NS;
 
@@ -48,46 +49,13 @@ void CoulFMMSleepers::use(const double *asleep, bigint gen)
   generation = gen;
 }
 
-/* ----------------------------------------------------------------------
-   the charged sleepers of the group on every rank, sorted by atom ID
-------------------------------------------------------------------------- */
-
+// the charged sleepers of the group on every rank, sorted by atom ID
 void CoulFMMSleepers::gather()
 {
-  std::vector<double> mine;
-  double **x = atom->x;
+  int *mask = atom->mask;
   double *q = atom->q;
-  for (int i = 0; i < atom->nlocal; i++) {
-    if (!(atom->mask[i] & groupbit) || q[i] == 0.0 || !asleep(i)) continue;
-    mine.insert(mine.end(), {(double) atom->tag[i], x[i][0], x[i][1], x[i][2], q[i]});
-  }
-  const int nprocs = comm->nprocs;
-  std::vector<int> counts(nprocs), displs(nprocs);
-  int n = (int) mine.size(), total = 0;
-  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
-  for (int p = 0; p < nprocs; p++) {
-    displs[p] = total;
-    total += counts[p];
-  }
-  std::vector<double> all(total);
-  MPI_Allgatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, world);
-  const size_t ns = total / 5;
-  std::vector<size_t> order(ns);
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return all[5 * a] < all[5 * b]; });
-  sx.resize(ns);
-  sy.resize(ns);
-  sz.resize(ns);
-  sq.resize(ns);
-  stag.resize(ns);
-  for (size_t k = 0; k < ns; k++) {
-    const double *r = &all[5 * order[k]];
-    stag[k] = (tagint) r[0];
-    sx[k] = r[1];
-    sy[k] = r[2];
-    sz[k] = r[3];
-    sq[k] = r[4];
-  }
+  CoulFMMComm(lmp).gather([&](int i) { return (mask[i] & groupbit) && q[i] != 0.0 && asleep(i); },
+                          sources);
 }
 
 void CoulFMMSleepers::prepare()
@@ -104,7 +72,8 @@ void CoulFMMSleepers::prepare()
     // boundary f in z keeps every atom in the box: one far-field column for the run
     field->set_z_range(box[4], box[5]);
   }
-  field->set_sources(sx.size(), sx.data(), sy.data(), sz.data(), sq.data());
+  field->set_sources(sources.size(), sources.x.data(), sources.y.data(), sources.z.data(),
+                     sources.q.data());
   built_generation = generation;
   std::copy(box, box + 6, built_box);
   nrebuilds++;
@@ -114,7 +83,7 @@ double CoulFMMSleepers::add_field(const double *x, const double *y, const double
                                   const double *q, size_t first, size_t last, double *pot,
                                   double *ex, double *ey, double *ez)
 {
-  if (last <= first || sx.empty()) return 0.0;
+  if (last <= first || sources.size() == 0) return 0.0;
   const size_t m = last - first;
   std::vector<double> r(4 * m);
   field->evaluate(m, x + first, y + first, z + first, r.data(), r.data() + m, r.data() + 2 * m,
@@ -132,10 +101,10 @@ double CoulFMMSleepers::add_field(const double *x, const double *y, const double
 
 double CoulFMMSleepers::source_energy()
 {
-  return sx.empty() ? 0.0 : field->source_energy();
+  return sources.size() == 0 ? 0.0 : field->source_energy();
 }
 
 double CoulFMMSleepers::memory_usage() const
 {
-  return (double) field->memory_bytes() + 5.0 * sizeof(double) * sx.size();
+  return (double) field->memory_bytes() + 5.0 * sizeof(double) * sources.size();
 }

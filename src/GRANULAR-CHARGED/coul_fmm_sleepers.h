@@ -10,6 +10,7 @@
 #ifndef LMP_COUL_FMM_SLEEPERS_H
 #define LMP_COUL_FMM_SLEEPERS_H
 
+#include "coul_fmm_comm.h"
 #include "pointers.h"
 
 #include <memory>
@@ -49,11 +50,11 @@ class CoulFMMSleepers : protected Pointers {
   // change of the set
   double source_energy();
 
-  bigint sources() const { return (bigint) sx.size(); }
+  bigint nsources() const { return (bigint) sources.size(); }
   bigint rebuilds() const { return nrebuilds; }
   double memory_usage() const;
   // ID of the sleeping atom at position k of the gathered set (error messages)
-  tagint source_tag(size_t k) const { return k < stag.size() ? stag[k] : -1; }
+  tagint source_tag(size_t k) const { return k < sources.size() ? sources.tag[k] : -1; }
 
  private:
   std::unique_ptr<gcfmm::StaticSourceField> field;
@@ -62,8 +63,7 @@ class CoulFMMSleepers : protected Pointers {
   bigint generation, built_generation;
   double built_box[6];
   bigint nrebuilds;
-  std::vector<double> sx, sy, sz, sq;
-  std::vector<tagint> stag;
+  GatheredCharges sources;
   void gather();
 };
 

@@ -234,17 +234,20 @@ TEST(CoulFMM, BadInput)
                          "fix fmm all coul/fmm", "run 0 post no"}),
                "requires a 3d simulation");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm bogus 1"), "Unknown fix coul/fmm keyword: bogus");
-  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm accuracy 0"), "accuracy must be in \\(0, 1\\), got 0");
-  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm accuracy 1"), "accuracy must be in \\(0, 1\\), got 1");
-  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm order 0"), "order must be in \\[1, .*\\], got 0");
-  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm leaf 0"), "leaf must be >= 1, got 0");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm accuracy 0"), "accuracy must be in \\(0,1\\), got 0");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm accuracy 1"), "accuracy must be in \\(0,1\\), got 1");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm order 31"), "order must be <= 30, got 31");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm leaf -1"), "leaf must be >= 0 \\(0 = auto\\), got -1");
+  // checked once, by gcfmm::Options::validate() (0 means automatic for order, theta and leaf)
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm theta 1"), "theta must be in \\[0,1\\) \\(0 = auto\\), got 1");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm images 21"), "images must be <= 20, got 21");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm images -1"), "images must be >= 0, got -1");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm images 0"), "farfield exact with boundary p p f needs images >= 1, got images 0");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm farfield maybe"), "farfield must be exact, average or none, got maybe");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm every 0"), "every must be >= 1, got 0");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm near -1"), "near cutoff must be >= 0, got -1");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm check -1"), "check must be >= 0, got -1");
-  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm tolerance -1e-4 every 8"), "tolerance must be in \\[0, 1\\), got -1e-4");
+  expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm tolerance -1e-4 every 8"), "tolerance must be in \\[0, 1\\), got -0.0001");
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm tolerance 1e-4"), "tolerance 0.0001 needs every > 1");
 }
 

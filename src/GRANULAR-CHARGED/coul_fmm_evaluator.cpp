@@ -1,0 +1,232 @@
+/* ----------------------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+#include "coul_fmm_evaluator.h"
+
+#include "coul_fmm_sleepers.h"
+#include "fix_sleep_gran.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "domain.h"
+#include "error.h"
+#include "force.h"
+
+#include "gcfmm/far_field.hpp"
+#include "gcfmm/options.hpp"
+#include "gcfmm/solver.hpp"
+
+#include <exception>
+
+using namespace LAMMPS_NS;
+
+namespace {
+// a coincidence involving a static source, with its message in atom IDs
+struct SleeperCoincidence {
+  std::string message;
+};
+}    // namespace
+
+CoulFMMEvaluator::CoulFMMEvaluator(LAMMPS *lmp, const std::string &id, int bit) :
+    Pointers(lmp), fix_id(id), groupbit(bit), opts(new gcfmm::Options), solver_boundary(-1),
+    mpi(lmp), sleep_fix(nullptr), pair_energy(0.0), logged(false)
+{
+}
+
+CoulFMMEvaluator::~CoulFMMEvaluator() = default;
+
+void CoulFMMEvaluator::init(const gcfmm::Options &options, FixSleepGran *sleep)
+{
+  *opts = options;
+  // the solver (tree memory, far-field operator) is kept across runs; the boundary is the only
+  // option init() can change
+  const bool solver_new = !solver || solver_boundary != (int) opts->boundary;
+  try {
+    if (solver_new) solver = std::make_unique<gcfmm::Solver>(*opts);
+    if (!sleep)
+      sleepers.reset();
+    else if (solver_new || !sleepers)
+      sleepers = std::make_unique<CoulFMMSleepers>(lmp, *opts, groupbit);
+  } catch (std::exception &e) {
+    error->all(FLERR, "Fix coul/fmm: FMM library: {}", e.what());
+  }
+  solver_boundary = (int) opts->boundary;
+  sleep_fix = sleep;
+  logged = false;
+}
+
+void CoulFMMEvaluator::update_sleepers()
+{
+  if (sleepers) sleepers->use(sleep_fix->sleeping(), sleep_fix->generation());
+}
+
+bool CoulFMMEvaluator::asleep(int i) const
+{
+  return sleepers && sleepers->asleep(i);
+}
+
+/* ---------------------------------------------------------------------- */
+
+void CoulFMMEvaluator::evaluate(double **out, int col, bool split)
+{
+  update_sleepers();
+  split = split && split_active();
+  int *mask = atom->mask;
+  double *q = atom->q;
+  mpi.gather([&](int i) { return (mask[i] & groupbit) && q[i] != 0.0 && !(split && asleep(i)); },
+             gathered);
+  const int nlocal = atom->nlocal;
+  for (int i = 0; i < nlocal; i++)
+    for (int k = 0; k < 4; k++) out[i][col + k] = 0.0;
+  if (split) {
+    pair_energy = 0.0;    // a full evaluation (keyword check) keeps the split's
+    // the same sleepers on every rank: a failure here is seen by all
+    try {
+      sleepers->prepare();
+    } catch (gcfmm::CoincidentParticles &e) {
+      error->all(FLERR, "Fix coul/fmm: sleeping atoms {} and {} are at the same position: their "
+                 "Coulomb force is not defined", sleepers->source_tag(e.first()),
+                 sleepers->source_tag(e.second()));
+    } catch (std::exception &e) {
+      error->all(FLERR, "Fix coul/fmm: FMM library (static sleepers): {}", e.what());
+    }
+  }
+  if (gathered.size() == 0) return;
+
+  // a failure may be seen by one rank only (it owns the offending targets): agree on it
+  const std::string failure = mpi.first_failure(solve(split));
+  if (!failure.empty())
+    error->all(FLERR, Error::NOLASTLINE, "Fix coul/fmm: FMM library: {}", failure);
+
+  mpi.return_to_owners(gathered, values, mine);
+  // the received block is in the order gather() took this rank's atoms;
+  // bare 1/r kernel -> LAMMPS units: qqrd2e includes the dielectric constant
+  const double c = force->qqrd2e;
+  size_t m = 0;
+  for (int i = 0; i < nlocal; i++) {
+    if (!(mask[i] & groupbit) || q[i] == 0.0 || (split && asleep(i))) continue;
+    for (int k = 0; k < 4; k++) out[i][col + k] = c * mine[4 * m + k];
+    m++;
+  }
+  log_parameters();
+}
+
+/* ----------------------------------------------------------------------
+   the solver on the gathered charges, this rank's share of the targets into `values` (Ex, Ey,
+   Ez, phi per gathered atom, zero for the other ranks' shares); returns "" or what failed
+------------------------------------------------------------------------- */
+
+std::string CoulFMMEvaluator::solve(bool split)
+{
+  const size_t n = gathered.size();
+  result.assign(4 * n, 0.0);
+  double *pot = result.data(), *ex = pot + n, *ey = pot + 2 * n, *ez = pot + 3 * n;
+  double qpot = 0.0;    // sum q pot^sleepers over this rank's share
+  std::string failure;
+  try {
+    if (opts->boundary == gcfmm::Boundary::Periodic2D) {
+      solver->set_box(domain->boxlo[0], domain->boxlo[1], domain->xprd, domain->yprd);
+      // with boundary f in z every atom stays in the box: one far-field set-up for the run
+      // instead of one each time the charges' z range grows (e.g. during a deposition)
+      solver->set_z_range(domain->boxlo[2], domain->boxhi[2]);
+    }
+    solver->build(n, gathered.x.data(), gathered.y.data(), gathered.z.data());
+    // the ranks share the far field's anterpolation, which every one of them would otherwise
+    // repeat: each computes its share, one in-place sum completes it (exact)
+    const gcfmm::PartSum sum = [this](double *data, std::size_t count) {
+      mpi.sum(data, (int) count);
+    };
+    solver->evaluate(gathered.q.data(), pot, ex, ey, ez, comm->me, comm->nprocs, sum);
+    // the potential whose energy 1/2 sum q_i u_i has minus the applied forces as gradient
+    // (differs from pot only for farfield average; doc/theory.md, eq. (4.10))
+    solver->energy_potential(pot);
+    if (split) {
+      // the sleepers' field at this rank's share of the awake targets (the return to the
+      // owners sums the shares; the solver's own parts are disjoint the same way)
+      const size_t first = n * comm->me / comm->nprocs, last = n * (comm->me + 1) / comm->nprocs;
+      try {
+        qpot = sleepers->add_field(gathered.x.data(), gathered.y.data(), gathered.z.data(),
+                                   gathered.q.data(), first, last, pot, ex, ey, ez);
+      } catch (gcfmm::CoincidentParticles &e) {
+        throw SleeperCoincidence{fmt::format(
+            "atom {} is at the position of the sleeping atom {} (closer than {:g} of the "
+            "solver's length unit): their Coulomb force is not defined",
+            gathered.tag[first + e.first()], sleepers->source_tag(e.second()),
+            gcfmm::kCoincidenceRadius)};
+      }
+    }
+  } catch (SleeperCoincidence &e) {
+    failure = e.message;
+  } catch (gcfmm::CoincidentParticles &e) {
+    failure = fmt::format("atoms {} and {} are at the same position (closer than {:g} of the "
+                          "solver's length unit): their Coulomb force is not defined",
+                          gathered.tag[e.first()], gathered.tag[e.second()],
+                          gcfmm::kCoincidenceRadius);
+  } catch (gcfmm::FarFieldTooLarge &e) {
+    // the column's height (box or charges) sets the cost of the exact far field
+    failure = fmt::format("{}. In LAMMPS terms: the charged column (or the box in z, with "
+                          "boundary p p f) is {:.3g} times the cell side; use farfield average or "
+                          "none, a box or a wall that keeps the particles lower (a lid), or "
+                          "remove escaping particles (e.g. fix evaporate)",
+                          e.what(), e.height_over_side());
+  } catch (std::exception &e) {
+    failure = e.what();
+    if (failure.empty()) failure = "unknown error";
+  }
+  if (split) {
+    mpi.sum(&qpot, 1);
+    pair_energy = 0.5 * force->qqrd2e * qpot;
+  }
+  values.resize(4 * n);
+  for (size_t k = 0; k < n; k++) {
+    double *slot = &values[4 * k];
+    slot[0] = ex[k];
+    slot[1] = ey[k];
+    slot[2] = ez[k];
+    slot[3] = pot[k];
+  }
+  return failure;
+}
+
+void CoulFMMEvaluator::log_parameters()
+{
+  if (logged) return;
+  logged = true;
+  if (comm->me != 0) return;
+  const auto &st = solver->stats();
+  static const char *ffname[] = {"none", "average", "exact"};
+  const bool free_space = opts->boundary == gcfmm::Boundary::Free;
+  utils::logmesg(lmp,
+                 "FMM Coulomb (fix coul/fmm {}): {} charged atoms, {}\n"
+                 "  order = {}, theta = {:.3g}, leaf = {}, levels = {}{}\n"
+                 "  estimated relative RMS force error = {:.3g} (requested accuracy {:.3g})\n",
+                 fix_id, gathered.size(), free_space ? "free space" : "periodic in x y", st.order,
+                 st.theta, st.leaf, st.levels,
+                 free_space ? std::string()
+                            : fmt::format(", images = {}, farfield = {}", opts->images,
+                                          ffname[(int) opts->farfield]),
+                 st.estimated_error, opts->accuracy);
+}
+
+double CoulFMMEvaluator::sleeper_source_energy()
+{
+  return sleepers ? force->qqrd2e * sleepers->source_energy() : 0.0;
+}
+
+const gcfmm::Stats *CoulFMMEvaluator::stats() const
+{
+  return solver ? &solver->stats() : nullptr;
+}
+
+double CoulFMMEvaluator::memory_usage() const
+{
+  double bytes = (double) (gathered.x.capacity() * 14) * sizeof(double);    // gathered + results
+  if (sleepers) bytes += sleepers->memory_usage();
+  return bytes;
+}

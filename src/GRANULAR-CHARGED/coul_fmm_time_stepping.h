@@ -1,0 +1,190 @@
+/* -*- c++ -*- ----------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+// The multiple time stepping of fix coul/fmm (doc/theory.md, eqs. (5.1)-(5.4)): between two
+// evaluations of the FMM the far part of each atom's field is extrapolated with its slope and
+// the pairs closer than a cutoff are summed afresh; the evaluation interval adapts to a
+// tolerance. No LAMMPS headers: the fix owns the per-atom arrays and the communication, this
+// class the numerics on one atom's row (or one pair) at a time, so it is tested alone
+// (unittest/lammps/test_coul_fmm_time_stepping.cpp).
+
+#ifndef LMP_COUL_FMM_TIME_STEPPING_H
+#define LMP_COUL_FMM_TIME_STEPPING_H
+
+#include <cstdint>
+#include <cstring>
+
+namespace LAMMPS_NS {
+
+class CoulFMMTimeStepping {
+ public:
+  // one atom's state of the last evaluation (a row of the fix's per-atom array)
+  enum Column : int {
+    X = 0,           // unwrapped position at the evaluation (3)
+    Q = 3,           // charge at the evaluation (0 outside the group)
+    FIELD = 4,       // evaluated Ex, Ey, Ez, phi (4)
+    SLOPE = 8,       // change of the far part per step, from the last two evaluations (4)
+    LAST_X = 12,     // unwrapped position when a field was last applied (3)
+    SLOPE_A = 15,    // unwrapped positions at the two evaluations the slope was taken over
+    SLOPE_B = 18,    // (3 each): the trend of a pair inside the slope, for the near refresh
+    IN_SLOPE = 21,   // 1 if the slope covers this atom's pairs (it existed at both evaluations)
+    ASLEEP = 22,     // 1 if the atom was a static source (fix sleep/gran) at the evaluation
+    COLS = 23
+  };
+  // rows of restart files written before ASLEEP existed
+  static constexpr int COLS_V1 = 22;
+
+  // one atom's displacements for the near refresh (local atoms and ghosts): since the
+  // evaluation, since the two evaluations of the slope, and whether the slope covers it
+  enum Delta : int { DELTA_E = 0, DELTA_A = 3, DELTA_B = 6, DELTA_IN_SLOPE = 9, DELTA_COLS = 10 };
+
+  // the keywords of the scheme, checked once by validate()
+  struct Settings {
+    int every = 1;             // fixed: evaluate on multiples of every; adaptive: largest interval
+    double tolerance = 0.0;    // adaptive: error allowed per interval (0: fixed interval)
+    bool extrapolate = true;   // extrapolate the far part linearly between evaluations
+    double near_cutoff = 0.0;  // pairs closer than this are summed afresh every step (0: off)
+    int check_every = 0;       // measure the scheme's error every this many steps (0: never)
+    // throws std::invalid_argument "<keyword> must be ..., got <value>"
+    void validate() const;
+  };
+
+  // how the stored evaluation relates to the atoms now (the fix measures it)
+  enum class Continuity { NONE, SAME, ADDED };
+
+  // what a new evaluation does with the stored state
+  struct Plan {
+    bool same = false;        // the same charges as at the last evaluation
+    bool keep_slope = false;  // the stored slope stays valid (same charges, or only added ones)
+    bool new_slope = false;   // a whole interval passed: take a new slope over it
+    bool near = false;        // the near refresh is part of the prediction
+    double steps = 0.0;       // steps since the last evaluation (same charges only)
+  };
+
+  // validates the settings; with a tolerance, every becomes the power of two at or below it
+  // (the evaluation steps of a shorter interval then include those of a longer one)
+  explicit CoulFMMTimeStepping(const Settings &settings);
+
+  const Settings &settings() const { return set; }
+  bool refreshes_near() const { return set.near_cutoff > 0.0 && set.every > 1; }
+
+  // ---- schedule (eq. (5.4)) ----
+  // an evaluation is due on the multiples of the interval (a schedule that does not depend on
+  // where a run starts) and when none was made yet
+  bool scheduled(int64_t step) const
+  {
+    return evaluated.step < 0 || (step % interval == 0 && step != evaluated.step);
+  }
+  int stride() const { return interval; }
+  // the stored field cannot be continued: no evaluation to continue, an adaptive schedule
+  // starts again from 1
+  void restart_schedule();
+  // halve the interval while the measured error exceeds the tolerance, double it when even
+  // the doubled interval would stay below half of it
+  void adapt(double error);
+  // the error measured at the last evaluation that continued a field (-1: none yet)
+  double last_estimate() const { return estimate; }
+  // steps between the two evaluations of the last slope
+  double slope_interval() const { return slope_steps; }
+
+  // ---- one evaluation (eqs. (5.2)-(5.3)) ----
+  // with_slope false: a field of its own, nothing continued (a minimizer step)
+  Plan plan(Continuity continuity, bool with_slope, int64_t step) const;
+  // the share of a pair's trend that the extrapolation has added `steps` after the evaluation
+  double trend_factor(double steps) const;
+  // eq. (5.2): the field applied `steps` after the evaluation, near = the near refresh or null
+  void predict(const double *state, double steps, const double *near, double out[4]) const;
+  // before the new evaluation overwrites the row: the field the scheme would have applied now
+  // (`predicted`), the first half of a new slope (E(t_e) + D), the evaluation's position xu,
+  // charge q (0 outside the group) and whether it is a static source now
+  void begin_evaluation(const Plan &plan, double *state, const double xu[3], double q, bool asleep,
+                        const double *near_now, const double *near_then, double predicted[4]) const;
+  // after the evaluation wrote FIELD: the new slope S = (E(t) - E(t_e) - D) / (t - t_e) and the
+  // sums of squares of the prediction error (add_error_sums)
+  void end_evaluation(const Plan &plan, double *state, const double predicted[4],
+                      double sums[2]) const;
+  // the whole set: the interval of a new slope, and the adapted schedule from the error of the
+  // prediction (relative_rms of the summed sums)
+  void finish_evaluation(const Plan &plan, double error);
+
+  // eq. (5.3): the change of (K, 1/r) of one pair since the evaluation, K(r) = r / |r|^3,
+  // r = now the separation, di, dj the two atoms' Delta rows. trend < 0: the D of a new slope
+  // (pairs closer than the cutoff now); trend >= 0: the refresh between evaluations (pairs
+  // closer now or at the evaluation), minus trend times the change over the slope's interval
+  // of the pairs the slope carries. False (dg untouched) if the pair is not refreshed.
+  bool near_pair_change(const double now[3], const double *di, const double *dj, double trend,
+                        double dg[4]) const;
+  // an atom's Delta row from its unwrapped position now and its state
+  static void displacements(const double xu[3], const double *state, double *delta);
+
+  // ---- error measure ----
+  // sums[0] += q2 |applied - reference|^2, sums[1] += q2 |reference|^2 (the field, 3 components)
+  static void add_error_sums(double q2, const double *applied, const double *reference,
+                             double sums[2]);
+  // sqrt(sums[0] / sums[1]), 0 without a reference field
+  static double relative_rms(const double sums[2]);
+
+  // keyword check: one measurement (global sums of add_error_sums)
+  void record_check(const double sums[2]);
+  double check_last() const { return last_check; }
+  double check_max() const { return max_check; }
+  double check_overall() const;    // all checks together (their sums of squares)
+
+  // ---- what the stored evaluation belongs to ----
+  struct Evaluated {
+    int64_t step = -1;          // step of the last evaluation (-1: none yet)
+    double box[4] = {0, 0, 0, 0};    // xlo, ylo, Lx, Ly then
+    uint64_t charges = 0;       // sum of coul_fmm_charge_hash over the charged atoms then
+    double qqrd2e = 0.0;        // Coulomb constant (units, dielectric) then
+    int boundary = -1;          // the solver's boundary then (-1: none)
+  };
+  Evaluated evaluated;
+  // the same boundary, Coulomb constant and (periodic) cell as at the last evaluation
+  bool same_setting(int boundary, double qqrd2e, const double box[4], bool periodic) const;
+  // from the global sums over the atoms: [0] coul_fmm_charge_hash of the evaluation's charges
+  // still present, [1] atoms whose charge differs from the evaluation's (a created atom had 0),
+  // [2] those of them charged at the evaluation (changed, not added), [3] charged atoms that
+  // were static sources then and are awake now (no stored field, like added ones)
+  Continuity continuity(const uint64_t sums[4]) const;
+
+  // ---- restart: the settings, schedule and Evaluated ----
+  static constexpr int RESTART_SIZE = 14;
+  void write_restart(double list[RESTART_SIZE]) const;
+  // false (nothing restored: evaluate afresh) for a file of an older format or of other settings
+  bool read_restart(const double *list);
+
+ private:
+  Settings set;
+  int interval;          // evaluations on the steps that are multiples of it
+  double estimate;       // error measured at the last evaluation that continued a field
+  double slope_steps;    // steps between the two evaluations of the slope
+  double last_check, max_check, check_sums[2];
+};
+
+// hash of one charged atom (ID, charge bits) for the checksum of the charges: summed modulo
+// 2^64 over the atoms, so the sum does not depend on their order or on the ranks holding them
+// (splitmix64 finaliser: a changed charge or ID changes the sum except with odds ~2^-64)
+inline uint64_t coul_fmm_mix64(uint64_t z)
+{
+  z += 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+inline uint64_t coul_fmm_charge_hash(int64_t tag, double q)
+{
+  uint64_t bits;
+  std::memcpy(&bits, &q, sizeof(bits));
+  return coul_fmm_mix64((uint64_t) tag ^ coul_fmm_mix64(bits));
+}
+
+}    // namespace LAMMPS_NS
+
+#endif
