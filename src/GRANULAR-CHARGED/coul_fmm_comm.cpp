@@ -40,16 +40,17 @@ void CoulFMMComm::gather(const std::function<bool(int)> &take, GatheredCharges &
     total += counts[p];
   }
   all.resize(total);
-  MPI_Allgatherv(buf.data(), mine, MPI_DOUBLE, all.data(), counts.data(), displs.data(),
-                 MPI_DOUBLE, world);
+  MPI_Allgatherv(buf.data(), mine, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE,
+                 world);
   out.counts.resize(nprocs);
   for (int p = 0; p < nprocs; p++) out.counts[p] = counts[p] / 5;
 
   const size_t n = total / 5;
   out.order.resize(n);
   std::iota(out.order.begin(), out.order.end(), 0);
-  std::sort(out.order.begin(), out.order.end(),
-            [&](size_t a, size_t b) { return all[5 * a] < all[5 * b]; });
+  std::sort(out.order.begin(), out.order.end(), [&](size_t a, size_t b) {
+    return all[5 * a] < all[5 * b];
+  });
   out.tag.resize(n);
   out.x.resize(n);
   out.y.resize(n);

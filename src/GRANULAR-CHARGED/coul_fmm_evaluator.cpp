@@ -16,12 +16,19 @@
 #include "comm.h"
 #include "domain.h"
 #include "error.h"
+#include "fix.h"
 #include "force.h"
+#include "group.h"
+#include "memory.h"
+#include "modify.h"
+#include "pair.h"
+#include "update.h"
 
 #include "gcfmm/far_field.hpp"
 #include "gcfmm/options.hpp"
 #include "gcfmm/solver.hpp"
 
+#include <algorithm>
 #include <exception>
 
 using namespace LAMMPS_NS;
@@ -35,15 +42,99 @@ struct SleeperCoincidence {
 
 CoulFMMEvaluator::CoulFMMEvaluator(LAMMPS *lmp, const std::string &id, int bit) :
     Pointers(lmp), fix_id(id), groupbit(bit), opts(new gcfmm::Options), solver_boundary(-1),
-    mpi(lmp), sleep_fix(nullptr), pair_energy(0.0), logged(false)
+    mpi(lmp), fresh(nullptr), nmax_fresh(0), sleep_fix(nullptr), pair_energy(0.0), logged(false)
 {
 }
 
-CoulFMMEvaluator::~CoulFMMEvaluator() = default;
+CoulFMMEvaluator::~CoulFMMEvaluator()
+{
+  memory->destroy(fresh);
+}
 
-void CoulFMMEvaluator::init(const gcfmm::Options &options, FixSleepGran *sleep)
+void CoulFMMEvaluator::set_geometry(gcfmm::Options &o, bool bed_given)
+{
+  const int px = domain->xperiodic, py = domain->yperiodic, pz = domain->zperiodic;
+  if (!px && !py && !pz)
+    o.boundary = gcfmm::Boundary::Free;
+  else if (px && py && !pz)
+    o.boundary = gcfmm::Boundary::Periodic2D;
+  else
+    error->all(FLERR,
+               "Fix coul/fmm requires boundary f f f (free space) or p p f (periodic in x "
+               "and y, open in z), got periodicity {} {} {}",
+               px ? "p" : "f", py ? "p" : "f", pz ? "p" : "f");
+  const bool periodic = o.boundary == gcfmm::Boundary::Periodic2D;
+  const bool exact = periodic && o.farfield == gcfmm::FarField::Exact;
+  if (exact && o.images == 0)
+    error->all(FLERR,
+               "Fix coul/fmm farfield exact with boundary p p f needs images >= 1, got "
+               "images 0 (the far-field kernel of the exact lattice sum is singular inside the "
+               "cell then): use images >= 1, or farfield average or none");
+  // the exact far field meets the requested accuracy only for cells close to square
+  const double aspect = MAX(domain->xprd, domain->yprd) / MIN(domain->xprd, domain->yprd);
+  if (exact && aspect > gcfmm::PeriodicFarField::kMaxAspect)
+    error->all(FLERR,
+               "Fix coul/fmm farfield exact supports cells with max(Lx, Ly) / min(Lx, Ly) "
+               "<= {:g}, got {:g}: use farfield average or none, or a cell closer to square",
+               gcfmm::PeriodicFarField::kMaxAspect, aspect);
+  if (bed_given && !(periodic && o.farfield == gcfmm::FarField::Average))
+    error->all(FLERR,
+               "Fix coul/fmm keyword bed applies only to farfield average with boundary p p f");
+}
+
+void CoulFMMEvaluator::check_counted_once(Fix *self)
+{
+  const bool me0 = comm->me == 0;
+  if (force->kspace && me0)
+    error->warning(FLERR,
+                   "Fix coul/fmm is used together with a kspace style: Coulomb "
+                   "interactions may be counted twice");
+  // a pair style with a Coulomb part (coul/cut, lj/cut/coul/long, ... or a hybrid sub-style)
+  // adds the same interactions again for the pairs within its cutoff
+  int dim = 0;
+  if (force->pair && me0 && (force->pair->extract("cut_coul", dim) || force->pair_match("coul", 0)))
+    error->warning(FLERR,
+                   "Fix coul/fmm {} is used together with pair style {}, which computes "
+                   "Coulomb interactions too: they are counted twice within its cutoff (use a pair "
+                   "style without a coul part)",
+                   fix_id, force->pair_style);
+  // fixes on disjoint groups are allowed, but do not see each other
+  for (auto *other : modify->get_fix_by_style("^coul/fmm$")) {
+    if (other == self) continue;
+    const int both = groupbit | group->bitmask[other->igroup];
+    double shared = 0.0;
+    for (int i = 0; i < atom->nlocal; i++)
+      if ((atom->mask[i] & both) == both && atom->q[i] != 0.0) shared += 1.0;
+    mpi.sum(&shared, 1);
+    if (shared > 0.0)
+      error->all(FLERR,
+                 "Fix coul/fmm {} and fix coul/fmm {} share {} charged atoms: their "
+                 "Coulomb interactions would be counted twice",
+                 fix_id, other->id, (bigint) shared);
+    if (me0)
+      error->warning(FLERR,
+                     "Fix coul/fmm {} and fix coul/fmm {} act on disjoint groups: charges "
+                     "of one group do not interact with those of the other",
+                     fix_id, other->id);
+  }
+}
+
+void CoulFMMEvaluator::init(const gcfmm::Options &options, FixSleepGran *sleep, bool virial)
 {
   *opts = options;
+  if (sleep && opts->boundary == gcfmm::Boundary::Periodic2D &&
+      opts->farfield == gcfmm::FarField::Average)
+    error->all(FLERR,
+               "Fix coul/fmm {} farfield average cannot treat the sleepers of fix sleep/gran "
+               "{} as a static source (the average field is no pair interaction): use farfield "
+               "exact or none, or keyword sleepers full",
+               fix_id, sleep->id);
+  if (sleep && virial)
+    error->all(FLERR,
+               "Fix coul/fmm {}: the virial with the static sleepers of fix sleep/gran {} "
+               "would lack the sleepers' share (their forces are not computed): use keyword "
+               "sleepers full, or fix_modify {} virial no",
+               fix_id, sleep->id, fix_id);
   // the solver (tree memory, far-field operator) is kept across runs; the boundary is the only
   // option init() can change
   const bool solver_new = !solver || solver_boundary != (int) opts->boundary;
@@ -71,6 +162,81 @@ bool CoulFMMEvaluator::asleep(int i) const
   return sleepers && sleepers->asleep(i);
 }
 
+/* ----------------------------------------------------------------------
+   how the stored evaluation relates to the atoms now: SAME charges (same IDs, same values) in
+   the same geometry and units, charges ADDED (fix deposit; or static sources woken) with all
+   those of the evaluation still there and unchanged, or NONE. The sum of hashes is an integer
+   sum (modulo 2^64): exact and the same however the atoms are distributed.
+------------------------------------------------------------------------- */
+
+CoulFMMTimeStepping::Continuity CoulFMMEvaluator::continuity(const CoulFMMTimeStepping &scheme,
+                                                             double **state)
+{
+  using MTS = CoulFMMTimeStepping;
+  const double box[4] = {domain->boxlo[0], domain->boxlo[1], domain->xprd, domain->yprd};
+  if (!scheme.same_setting((int) opts->boundary, force->qqrd2e, box,
+                           opts->boundary == gcfmm::Boundary::Periodic2D))
+    return MTS::Continuity::NONE;
+  uint64_t sums[4] = {0, 0, 0, 0};    // as CoulFMMTimeStepping::continuity() reads them
+  update_sleepers();
+  for (int i = 0; i < atom->nlocal; i++) {
+    const double q = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0, q_then = state[i][MTS::Q];
+    if (q_then != 0.0) sums[0] += coul_fmm_charge_hash(atom->tag[i], q_then);
+    if (q != q_then) sums[1]++;
+    if (q != q_then && q_then != 0.0) sums[2]++;
+    if (q != 0.0 && state[i][MTS::ASLEEP] != 0.0 && !asleep(i)) sums[3]++;
+  }
+  mpi.sum(sums, 4);
+  return scheme.continuity(sums);
+}
+
+// unwrapping after a remap may differ in the last bits, hence a tolerance
+bool CoulFMMEvaluator::continues(const CoulFMMTimeStepping &scheme, double **state)
+{
+  using MTS = CoulFMMTimeStepping;
+  if (continuity(scheme, state) != MTS::Continuity::SAME) return false;
+  const double tol = 1e-12 * MAX(MAX(domain->xprd, domain->yprd), domain->zprd);
+  bool moved = false;
+  double xu[3];
+  for (int i = 0; i < atom->nlocal; i++) {
+    if (state[i][MTS::Q] == 0.0) continue;
+    domain->unmap(atom->x[i], atom->image[i], xu);
+    for (int k = 0; k < 3; k++) moved = moved || fabs(xu[k] - state[i][MTS::LAST_X + k]) > tol;
+  }
+  return !mpi.any(moved);
+}
+
+void CoulFMMEvaluator::measure_error(CoulFMMTimeStepping &scheme, double **applied)
+{
+  if (atom->nlocal > nmax_fresh) {
+    nmax_fresh = atom->nmax;
+    memory->destroy(fresh);
+    memory->create(fresh, nmax_fresh, 4, "coul/fmm:fresh");
+  }
+  evaluate(fresh, 0, false);
+  double sums[2] = {0.0, 0.0};
+  for (int i = 0; i < atom->nlocal; i++)
+    if (!asleep(i))
+      CoulFMMTimeStepping::add_error_sums(atom->q[i] * atom->q[i], applied[i], fresh[i], sums);
+  mpi.sum(sums, 2);
+  scheme.record_check(sums);
+}
+
+void CoulFMMEvaluator::record(CoulFMMTimeStepping &scheme, double **state)
+{
+  auto &then = scheme.evaluated;
+  then.charges = 0;
+  for (int i = 0; i < atom->nlocal; i++)
+    if (state[i][CoulFMMTimeStepping::Q] != 0.0)
+      then.charges += coul_fmm_charge_hash(atom->tag[i], state[i][CoulFMMTimeStepping::Q]);
+  mpi.sum(&then.charges, 1);
+  then.step = update->ntimestep;
+  then.qqrd2e = force->qqrd2e;
+  then.boundary = (int) opts->boundary;
+  const double box[4] = {domain->boxlo[0], domain->boxlo[1], domain->xprd, domain->yprd};
+  std::copy(box, box + 4, then.box);
+}
+
 /* ---------------------------------------------------------------------- */
 
 void CoulFMMEvaluator::evaluate(double **out, int col, bool split)
@@ -79,8 +245,11 @@ void CoulFMMEvaluator::evaluate(double **out, int col, bool split)
   split = split && split_active();
   int *mask = atom->mask;
   double *q = atom->q;
-  mpi.gather([&](int i) { return (mask[i] & groupbit) && q[i] != 0.0 && !(split && asleep(i)); },
-             gathered);
+  mpi.gather(
+      [&](int i) {
+        return (mask[i] & groupbit) && q[i] != 0.0 && !(split && asleep(i));
+      },
+      gathered);
   const int nlocal = atom->nlocal;
   for (int i = 0; i < nlocal; i++)
     for (int k = 0; k < 4; k++) out[i][col + k] = 0.0;
@@ -90,9 +259,10 @@ void CoulFMMEvaluator::evaluate(double **out, int col, bool split)
     try {
       sleepers->prepare();
     } catch (gcfmm::CoincidentParticles &e) {
-      error->all(FLERR, "Fix coul/fmm: sleeping atoms {} and {} are at the same position: their "
-                 "Coulomb force is not defined", sleepers->source_tag(e.first()),
-                 sleepers->source_tag(e.second()));
+      error->all(FLERR,
+                 "Fix coul/fmm: sleeping atoms {} and {} are at the same position: their "
+                 "Coulomb force is not defined",
+                 sleepers->source_tag(e.first()), sleepers->source_tag(e.second()));
     } catch (std::exception &e) {
       error->all(FLERR, "Fix coul/fmm: FMM library (static sleepers): {}", e.what());
     }
@@ -164,10 +334,10 @@ std::string CoulFMMEvaluator::solve(bool split)
   } catch (SleeperCoincidence &e) {
     failure = e.message;
   } catch (gcfmm::CoincidentParticles &e) {
-    failure = fmt::format("atoms {} and {} are at the same position (closer than {:g} of the "
-                          "solver's length unit): their Coulomb force is not defined",
-                          gathered.tag[e.first()], gathered.tag[e.second()],
-                          gcfmm::kCoincidenceRadius);
+    failure =
+        fmt::format("atoms {} and {} are at the same position (closer than {:g} of the "
+                    "solver's length unit): their Coulomb force is not defined",
+                    gathered.tag[e.first()], gathered.tag[e.second()], gcfmm::kCoincidenceRadius);
   } catch (gcfmm::FarFieldTooLarge &e) {
     // the column's height (box or charges) sets the cost of the exact far field
     failure = fmt::format("{}. In LAMMPS terms: the charged column (or the box in z, with "

@@ -16,6 +16,7 @@
 #define LMP_COUL_FMM_EVALUATOR_H
 
 #include "coul_fmm_comm.h"
+#include "coul_fmm_time_stepping.h"
 #include "pointers.h"
 
 #include <memory>
@@ -37,9 +38,26 @@ class CoulFMMEvaluator : protected Pointers {
   CoulFMMEvaluator(class LAMMPS *, const std::string &fix_id, int groupbit);
   ~CoulFMMEvaluator() override;
 
+  // opts.boundary from the box (free space or periodic in x and y only), and errors for the
+  // solver options this box rules out
+  void set_geometry(gcfmm::Options &opts, bool bed_given);
+  // warnings or errors for other styles that compute the same Coulomb interactions: a kspace
+  // style, a pair style with a coul part, another fix coul/fmm sharing charged atoms
+  void check_counted_once(class Fix *self);
   // a solver for these options (the one of the last run if its boundary is the same), the
-  // sleepers of `sleep` as a static source if given
-  void init(const gcfmm::Options &opts, FixSleepGran *sleep);
+  // sleepers of `sleep` as a static source if given (errors for what cannot use them)
+  void init(const gcfmm::Options &opts, FixSleepGran *sleep, bool virial);
+
+  // what the stored evaluation (state rows: CoulFMMTimeStepping::Column) belongs to: record()
+  // it before an evaluation, continuity() relates it to the atoms now
+  void record(CoulFMMTimeStepping &scheme, double **state);
+  CoulFMMTimeStepping::Continuity continuity(const CoulFMMTimeStepping &scheme, double **state);
+  // at the start of a run: the stored field belongs to the same atoms, charges and box, and no
+  // atom was moved since the field was last applied (displace_atoms, set)
+  bool continues(const CoulFMMTimeStepping &scheme, double **state);
+  // keyword check: the applied field against a fresh evaluation at the same positions (with
+  // static sleepers a full one: the error of the split and of the time stepping together)
+  void measure_error(CoulFMMTimeStepping &scheme, double **applied);
 
   // the sleepers' flags of this step (call before asleep())
   void update_sleepers();
@@ -66,6 +84,8 @@ class CoulFMMEvaluator : protected Pointers {
   CoulFMMComm mpi;
   GatheredCharges gathered;
   std::vector<double> result, values, mine;
+  double **fresh;    // the fresh evaluation of measure_error()
+  int nmax_fresh;
   FixSleepGran *sleep_fix;
   std::unique_ptr<CoulFMMSleepers> sleepers;
   double pair_energy;    // C/2 sum_awake q pot^sleepers at the last evaluation

@@ -36,8 +36,8 @@ gcfmm::Options static_options(const gcfmm::Options &opts)
 }    // namespace
 
 CoulFMMSleepers::CoulFMMSleepers(LAMMPS *lmp, const gcfmm::Options &opts, int groupbit_in) :
-    Pointers(lmp), field(new gcfmm::StaticSourceField(static_options(opts))), groupbit(groupbit_in), flags(nullptr),
-    generation(-1), built_generation(-2), built_box{0, 0, 0, 0, 0, 0}, nrebuilds(0)
+    Pointers(lmp), field(new gcfmm::StaticSourceField(static_options(opts))), groupbit(groupbit_in),
+    flags(nullptr), generation(-1), built_generation(-2), built_box{0, 0, 0, 0, 0, 0}, nrebuilds(0)
 {
 }
 
@@ -54,8 +54,11 @@ void CoulFMMSleepers::gather()
 {
   int *mask = atom->mask;
   double *q = atom->q;
-  CoulFMMComm(lmp).gather([&](int i) { return (mask[i] & groupbit) && q[i] != 0.0 && asleep(i); },
-                          sources);
+  CoulFMMComm(lmp).gather(
+      [&](int i) {
+        return (mask[i] & groupbit) && q[i] != 0.0 && asleep(i);
+      },
+      sources);
 }
 
 void CoulFMMSleepers::prepare()

@@ -44,8 +44,8 @@ void CoulFMMTimeStepping::Settings::validate() const
 }
 
 CoulFMMTimeStepping::CoulFMMTimeStepping(const Settings &settings) :
-    set(settings), interval(1), estimate(-1.0), slope_steps(0.0), last_check(0.0), max_check(0.0),
-    check_sums{0.0, 0.0}
+    set(settings), interval(1), estimate(-1.0), slope_steps(0.0), last_check(0.0),
+    max_check(0.0), check_sums{0.0, 0.0}
 {
   set.validate();
   if (set.tolerance > 0.0) set.every = 1 << (int) std::floor(std::log2((double) set.every));
@@ -114,8 +114,10 @@ void CoulFMMTimeStepping::begin_evaluation(const Plan &p, double *st, const doub
 {
   predict(st, p.keep_slope ? p.steps : 0.0, p.near ? near_now : nullptr, predicted);
   for (int k = 0; k < 4; k++) {
-    if (p.new_slope) st[SLOPE + k] = st[FIELD + k] + (p.near ? near_then[k] : 0.0);
-    else if (!p.keep_slope) st[SLOPE + k] = 0.0;
+    if (p.new_slope)
+      st[SLOPE + k] = st[FIELD + k] + (p.near ? near_then[k] : 0.0);
+    else if (!p.keep_slope)
+      st[SLOPE + k] = 0.0;
   }
   if (p.new_slope) {
     // the slope is taken over t_e -> now: remember both ends for the near refresh
@@ -159,8 +161,8 @@ void CoulFMMTimeStepping::finish_evaluation(const Plan &p, double error)
    same for every image of an atom, so periodic images need no special case)
 ------------------------------------------------------------------------- */
 
-bool CoulFMMTimeStepping::near_pair_change(const double now[3], const double *di,
-                                           const double *dj, double trend, double dg[4]) const
+bool CoulFMMTimeStepping::near_pair_change(const double now[3], const double *di, const double *dj,
+                                           double trend, double dg[4]) const
 {
   const double cutsq = set.near_cutoff * set.near_cutoff;
   double then[3];
@@ -204,8 +206,8 @@ void CoulFMMTimeStepping::displacements(const double xu[3], const double *state,
   delta[DELTA_IN_SLOPE] = state[IN_SLOPE];
 }
 
-void CoulFMMTimeStepping::add_error_sums(double q2, const double *applied,
-                                         const double *reference, double sums[2])
+void CoulFMMTimeStepping::add_error_sums(double q2, const double *applied, const double *reference,
+                                         double sums[2])
 {
   for (int k = 0; k < 3; k++) {
     sums[0] += q2 * (applied[k] - reference[k]) * (applied[k] - reference[k]);
@@ -255,8 +257,18 @@ namespace {
 // evaluation, >= -1, and hold no charge checksum)
 constexpr double kRestartFormat = -2.0;
 enum : int {
-  R_FORMAT, R_LAST, R_BOX, R_EVERY = R_BOX + 4, R_TOLERANCE, R_STRIDE, R_SLOPE, R_SUM_HI, R_SUM_LO,
-  R_QQRD2E, R_BOUNDARY, R_SIZE
+  R_FORMAT,
+  R_LAST,
+  R_BOX,
+  R_EVERY = R_BOX + 4,
+  R_TOLERANCE,
+  R_STRIDE,
+  R_SLOPE,
+  R_SUM_HI,
+  R_SUM_LO,
+  R_QQRD2E,
+  R_BOUNDARY,
+  R_SIZE
 };
 static_assert(R_SIZE == CoulFMMTimeStepping::RESTART_SIZE, "restart list size");
 }    // namespace

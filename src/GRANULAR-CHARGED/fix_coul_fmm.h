@@ -71,39 +71,26 @@ class FixCoulFMM : public Fix {
   std::unique_ptr<CoulFMMTimeStepping> stepping;  // the schedule and extrapolation
   std::unique_ptr<CoulFMMEvaluator> evaluator;    // atoms -> solver -> field
   std::unique_ptr<CoulFMMComm> mpi;
+  std::unique_ptr<class CoulFMMNearRefresh> near;    // the near refresh's list and buffers
   bool bed_given;                  // bed zlo/zhi given by the user (farfield average)
   std::string periodic_keyword;    // last of images/farfield given (ignored in free space)
   bool sleepers_static;            // keyword sleepers: static (true) or full
-  class FixSleepGran *sleep_fix;
 
   bigint nevaluations;             // evaluations so far (diagnostic)
 
   double energy_local, energy_all;
   bool energy_summed;
   int ilevel_respa;    // rRESPA level at which the Coulomb force is applied (outermost)
-  class NeighList *list;
 
   // per atom: Ex, Ey, Ez, potential (force/charge, energy/charge), the field applied
   double **field;
   // per atom: the state of the last evaluation (CoulFMMTimeStepping::Column)
   double **eval_state;
-  // scratch: displacements incl. ghosts (CoulFMMTimeStepping::Delta), near-pair changes, a
-  // fresh evaluation for keyword check
-  double **near_delta, **near_now, **near_then, **fresh;
-  int nmax_ghost, nmax_near, nmax_check;
 
   void parse_keywords(int narg, char **arg);
   void check_boundary_and_options();
-  void check_other_coul_fmm_fixes();
-  FixSleepGran *sleepers_to_use();
-  bool stored_field_valid();
-  CoulFMMTimeStepping::Continuity field_continuity();
-  void record_evaluation();
   void compute_field(bool with_slope);
   void advance_field();
-  void grow_near_buffers();
-  void near_pair_difference(double **out, double trend);
-  void measure_mts_error();
   void apply_field();
   void remember_positions();
 };

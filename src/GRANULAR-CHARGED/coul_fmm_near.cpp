@@ -1,0 +1,123 @@
+/* ----------------------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+#include "coul_fmm_near.h"
+
+#include "coul_fmm_time_stepping.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "domain.h"
+#include "fix.h"
+#include "force.h"
+#include "memory.h"
+#include "neigh_list.h"
+#include "neigh_request.h"
+#include "neighbor.h"
+
+using namespace LAMMPS_NS;
+using MTS = CoulFMMTimeStepping;
+
+CoulFMMNearRefresh::CoulFMMNearRefresh(LAMMPS *lmp, Fix *owner) :
+    Pointers(lmp), fix(owner), list(nullptr), delta(nullptr), near_now(nullptr), near_then(nullptr),
+    nmax_delta(0), nmax_out(0)
+{
+}
+
+CoulFMMNearRefresh::~CoulFMMNearRefresh()
+{
+  memory->destroy(delta);
+  memory->destroy(near_now);
+  memory->destroy(near_then);
+}
+
+void CoulFMMNearRefresh::request(double cutoff)
+{
+  auto *req = neighbor->add_request(fix, NeighConst::REQ_NEWTON_OFF);
+  req->set_cutoff(cutoff);
+  const double ghost = cutoff + neighbor->skin;
+  if (ghost > comm->cutghostuser) {
+    comm->cutghostuser = ghost;
+    if (comm->me == 0)
+      utils::logmesg(lmp, "Fix coul/fmm {}: ghost cutoff raised to {:.6g} for near {:.6g}\n",
+                     fix->id, ghost, cutoff);
+  }
+}
+
+void CoulFMMNearRefresh::compute(const MTS &scheme, double **eval_state, bool into_then,
+                                 double trend)
+{
+  const int nlocal = atom->nlocal, nall = nlocal + atom->nghost;
+  if (atom->nmax > nmax_out) {
+    nmax_out = atom->nmax;
+    memory->destroy(near_now);
+    memory->destroy(near_then);
+    memory->create(near_now, nmax_out, 4, "coul/fmm:near_now");
+    memory->create(near_then, nmax_out, 4, "coul/fmm:near_then");
+  }
+  if (nall > nmax_delta) {
+    nmax_delta = atom->nmax;
+    memory->destroy(delta);
+    memory->create(delta, nmax_delta, MTS::DELTA_COLS, "coul/fmm:near_delta");
+  }
+  double **x = atom->x, *q = atom->q, **out = into_then ? near_then : near_now;
+  int *mask = atom->mask;
+  const int groupbit = fix->groupbit;
+  double xu[3];
+  for (int i = 0; i < nlocal; i++) {
+    domain->unmap(x[i], atom->image[i], xu);
+    MTS::displacements(xu, eval_state[i], delta[i]);
+  }
+  comm->forward_comm(fix);
+  // each pair once: at i from j q_j dg, at j from i -q_i dg (field) and q_i dg (potential). A
+  // ghost j is a local atom elsewhere (or an image here) whose own list holds the pair the
+  // other way round: only i is updated.
+  for (int i = 0; i < nlocal; i++)
+    for (int k = 0; k < 4; k++) out[i][k] = 0.0;
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    if (!(mask[i] & groupbit) || q[i] == 0.0) continue;
+    double e[4] = {0.0, 0.0, 0.0, 0.0}, dg[4];
+    for (int jj = 0; jj < list->numneigh[i]; jj++) {
+      const int j = list->firstneigh[i][jj] & NEIGHMASK;
+      if (!(mask[j] & groupbit) || q[j] == 0.0) continue;
+      const double now[3] = {x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]};
+      if (!scheme.near_pair_change(now, delta[i], delta[j], trend, dg)) continue;
+      for (int k = 0; k < 4; k++) e[k] += q[j] * dg[k];
+      if (j < nlocal) {
+        for (int k = 0; k < 3; k++) out[j][k] -= q[i] * dg[k];
+        out[j][3] += q[i] * dg[3];
+      }
+    }
+    for (int k = 0; k < 4; k++) out[i][k] += e[k];
+  }
+  const double c = force->qqrd2e;
+  for (int i = 0; i < nlocal; i++)
+    for (int k = 0; k < 4; k++) out[i][k] *= c;
+}
+
+int CoulFMMNearRefresh::pack(int n, int *list_send, double *buf) const
+{
+  int m = 0;
+  for (int i = 0; i < n; i++)
+    for (int k = 0; k < MTS::DELTA_COLS; k++) buf[m++] = delta[list_send[i]][k];
+  return m;
+}
+
+void CoulFMMNearRefresh::unpack(int n, int first, const double *buf)
+{
+  int m = 0;
+  for (int i = first; i < first + n; i++)
+    for (int k = 0; k < MTS::DELTA_COLS; k++) delta[i][k] = buf[m++];
+}
+
+double CoulFMMNearRefresh::memory_usage() const
+{
+  return ((double) MTS::DELTA_COLS * nmax_delta + 8.0 * nmax_out) * sizeof(double);
+}

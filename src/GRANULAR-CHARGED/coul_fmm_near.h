@@ -1,0 +1,53 @@
+/* -*- c++ -*- ----------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+// The LAMMPS side of fix coul/fmm's near refresh (doc/theory.md, eq. (5.3)): the neighbor list
+// of the pairs closer than the near cutoff, the atoms' displacements since the evaluations
+// (forward-communicated to the ghosts through the fix) and the sum over the pairs; the pair
+// formula itself is CoulFMMTimeStepping::near_pair_change.
+
+#ifndef LMP_COUL_FMM_NEAR_H
+#define LMP_COUL_FMM_NEAR_H
+
+#include "pointers.h"
+
+namespace LAMMPS_NS {
+class CoulFMMTimeStepping;
+
+class CoulFMMNearRefresh : protected Pointers {
+ public:
+  CoulFMMNearRefresh(class LAMMPS *, class Fix *owner);
+  ~CoulFMMNearRefresh() override;
+
+  // a half list without newton (each pair once per rank that owns one of its atoms, so no
+  // reverse communication) of the pairs closer than cutoff, ghosts out to it
+  void request(double cutoff);
+  void set_list(class NeighList *ptr) { list = ptr; }
+
+  // C sum_j q_j (change of (K, 1/r) of pair ij since the evaluation) for the local atoms of the
+  // group into now() (trend >= 0: between evaluations) or then() (trend < 0: the D of a slope)
+  void compute(const CoulFMMTimeStepping &scheme, double **eval_state, bool into_then, double trend);
+  double **now() const { return near_now; }
+  double **then() const { return near_then; }
+
+  // the owner fix's forward communication of the displacements
+  int pack(int n, int *list_send, double *buf) const;
+  void unpack(int n, int first, const double *buf);
+  double memory_usage() const;
+
+ private:
+  class Fix *fix;
+  class NeighList *list;
+  double **delta, **near_now, **near_then;
+  int nmax_delta, nmax_out;
+};
+
+}    // namespace LAMMPS_NS
+
+#endif
