@@ -42,7 +42,7 @@ void build_lists(const Tree &targets, const Tree &sources, const std::vector<Vec
       const double d2 = dx * dx + dy * dy + dz * dz;
       const double rs = A.radius + B.radius;
       const double pairs = double(A.count()) * double(B.count());
-      // a multipole-only source has no particles: never P2P
+      // a multipole-only source lacks (some of) its particles: never P2P
       const bool truncated = multipole_only && (*multipole_only)[b];
       if (rs * rs < th2 * d2) {
         if (pairs <= pair_limit && !truncated) {
@@ -51,7 +51,7 @@ void build_lists(const Tree &targets, const Tree &sources, const std::vector<Vec
         } else {
           L.m2l.push_back({a, b, si});
         }
-      } else if (truncated && A.leaf()) {
+      } else if (truncated && A.leaf() && B.leaf()) {
         L.m2p.push_back({a, b, si});
       } else if (A.leaf() && B.leaf()) {
         L.p2p.push_back({a, b, si});

@@ -76,6 +76,7 @@ void Solver::build(std::size_t n, const double *x, const double *y, const double
   I.stats.t_build = timed([&] {
     I.build_tree(x, y, z);
     I.build_after_tree();
+    I.setup_far_field();
   });
   I.built = true;
   I.evaluated = false;

@@ -53,7 +53,7 @@ void SolverCore::build_scaled_tree(const double *x, const double *y, const doubl
   }
 }
 
-// The phases of build() after the tree, with the stats they determine.
+// The phases of build() after the tree but the far field, with the stats they determine.
 void SolverCore::build_after_tree() {
   build_interaction_lists();
   allocate_storage();
@@ -65,7 +65,6 @@ void SolverCore::build_after_tree() {
   stats.m2l_count = lists.m2l.size();
   stats.p2p_pairs = lists.p2p_pairs;
   stats.estimated_error = res.estimated_error;
-  setup_far_field();
 }
 
 // The source tree shifted by every image shift of the near block (doc/theory.md, eq. (4.1)).

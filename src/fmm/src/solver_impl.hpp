@@ -124,6 +124,20 @@ inline bool average_bed(const Options &o, double inv_h, std::size_t n, const dou
   return true;
 }
 
+// bytes held by a tree and by interaction lists (memory statistics)
+template <class T>
+inline std::size_t vector_bytes(const std::vector<T> &v) {
+  return v.capacity() * sizeof(T);
+}
+inline std::size_t tree_bytes(const Tree &t) {
+  return vector_bytes(t.nodes) + vector_bytes(t.cubes) + vector_bytes(t.perm) + vector_bytes(t.xs) +
+         vector_bytes(t.ys) + vector_bytes(t.zs) + vector_bytes(t.leaves);
+}
+inline std::size_t lists_bytes(const InteractionLists &l) {
+  return vector_bytes(l.shifts) + vector_bytes(l.m2l) + vector_bytes(l.p2p) + vector_bytes(l.m2p) +
+         vector_bytes(l.m2l_offset) + vector_bytes(l.p2p_offset) + vector_bytes(l.m2p_offset);
+}
+
 //! The targets of one work partition: sorted particle indices [begin, end).
 struct TargetRange {
   std::size_t begin = 0, end = 0;
@@ -248,7 +262,7 @@ struct SolverCore {
   void choose_length_unit(const double *x, const double *y, const double *z);
   void set_length_unit(double unit);
   void build_scaled_tree(const double *x, const double *y, const double *z);
-  // the phases of build() after build_tree()
+  // the phases of build() after build_tree() but setup_far_field()
   void build_after_tree();
   void build_interaction_lists();
   void allocate_storage();

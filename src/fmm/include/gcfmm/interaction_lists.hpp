@@ -8,9 +8,11 @@
 // M2L, unless n_A n_B <= pair_limit, where the direct sum is cheaper (then P2P). Rejected
 // pairs split the node with the larger radius (a leaf is never split); two rejected leaves
 // become P2P. Every (target particle, source particle, shift) triple is covered exactly once.
-// Optionally some source nodes are "multipole only" (a truncated node of a local essential
-// tree, doc/fmm-distributed.md: its multipole is known, its particles are not): an accepted
-// pair with such a source is always M2L, a rejected pair (target leaf, such a source) is M2P.
+// Optionally some source nodes are "multipole only" (in a local essential tree,
+// doc/fmm-distributed.md: a truncated node, whose multipole is known but not its particles, or
+// a node with a truncated descendant, whose particle range is incomplete): an accepted pair
+// with such a source is always M2L, a rejected pair (target leaf, such a source leaf) is M2P,
+// and such an internal source is split as any other.
 #ifndef GCFMM_INTERACTION_LISTS_HPP
 #define GCFMM_INTERACTION_LISTS_HPP
 
@@ -57,13 +59,15 @@ void build_lists(const Tree &tree, const std::vector<Vec3> &shifts, double theta
  *  `targets`' nodes, Interaction::source `sources`' nodes; the offsets are over the target
  *  nodes. Nothing is assumed about where the targets lie relative to the sources. Either tree
  *  may be empty (no entries).
- *  @param multipole_only null (every source node has its particles: the lists are exactly
- *         those of the two-tree traversal above, m2p empty) or one flag per source node;
- *         a flagged node must be a leaf of `sources` (nchild = 0) whose particles are absent:
- *         accepted pairs with it go to M2L whatever pair_limit says, rejected ones are split
- *         on the target side and, at a target leaf, go to the M2P list. The caller must make
- *         sure the multipole converges at those target particles (point MAC r_B < theta
- *         |x - c_B - s|, guaranteed by the LET criterion of doc/fmm-distributed.md). */
+ *  @param multipole_only null (every source node has all its particles: the lists are
+ *         exactly those of the two-tree traversal above, m2p empty) or one flag per source
+ *         node, set where the node's particle range lacks some of its particles (its multipole
+ *         is complete). Accepted pairs with a flagged source go to M2L whatever pair_limit
+ *         says; rejected ones are split as usual, and a rejected pair of a target leaf and a
+ *         flagged source leaf goes to the M2P list. The caller must make sure the multipole
+ *         converges at those target particles (point MAC r_B < theta |x - c_B - s|, guaranteed
+ *         by the LET criterion of doc/fmm-distributed.md) and flag every ancestor of a flagged
+ *         node too. */
 void build_lists(const Tree &targets, const Tree &sources, const std::vector<Vec3> &shifts, double theta,
                  double pair_limit, InteractionLists &lists, const std::vector<char> *multipole_only = nullptr);
 
