@@ -307,7 +307,53 @@ GCFMM_ALWAYS_INLINE void m2l_batch_body(const LaneState &st, std::size_t count, 
   }
 }
 
+GCFMM_ALWAYS_INLINE void m2p_batch_body(const LaneState &st, const double *M, const Vec3 &c, std::size_t np,
+                                       const double *x, const double *y, const double *z, double *pot, double *ex,
+                                       double *ey, double *ez) {
+  constexpr int W = kLanes;
+  const int p = st.p, S = st.S;
+  double *Tr = st.harm, *Ti = st.harm + S * W;
+  const double *mr = M, *mi = M + S;
+  for (std::size_t j0 = 0; j0 < np; j0 += W) {
+    double dx[W], dy[W], dz[W];
+    const int nl = gather_lanes(j0, np, x, y, z, c, dx, dy, dz);
+    for (int v = nl; v < W; ++v) dx[v] = 1.0;  // unused lanes: any point away from 0 (T is singular there)
+    solid_harmonics<Kind::Irregular, W>(p, p, st.nm1, dx, dy, dz, Tr, Ti);
+    fill_negative_m<W>(p, Tr, Ti);
+    // eq. (3.11) for n = 0 and n = 1 about the point: L_0^0 = sum_{k<=p,l} M_k^l T_k^l (= phi,
+    // eq. (3.8)), L_1^m = -sum_{k<=p-1,l} M_k^l T_{1+k}^{m+l}, m = 0, 1
+    double ph[W], l10[W], l11r[W], l11i[W];
+    for (int v = 0; v < W; ++v) ph[v] = l10[v] = l11r[v] = l11i[v] = 0.0;
+    for (int k = 0; k <= p; ++k)
+      for (int l = -k; l <= k; ++l) {
+        const double Mr = mr[idx(k, l)], Mi = mi[idx(k, l)];
+        const int i0 = idx(k, l) * W;
+#pragma omp simd
+        for (int v = 0; v < W; ++v) ph[v] += Mr * Tr[i0 + v] - Mi * Ti[i0 + v];
+        if (k == p) continue;
+        const int i1 = idx(k + 1, l) * W, i2 = idx(k + 1, l + 1) * W;
+#pragma omp simd
+        for (int v = 0; v < W; ++v) {
+          l10[v] += Mr * Tr[i1 + v] - Mi * Ti[i1 + v];
+          l11r[v] += Mr * Tr[i2 + v] - Mi * Ti[i2 + v];
+          l11i[v] += Mr * Ti[i2 + v] + Mi * Tr[i2 + v];
+        }
+      }
+    // eq. (3.13) at r = 0 with L_1 = -(the sums): E = (Re L_1^1, Im L_1^1, -L_1^0)
+    for (int v = 0; v < nl; ++v) {
+      pot[j0 + v] += ph[v];
+      ex[j0 + v] -= l11r[v];
+      ey[j0 + v] -= l11i[v];
+      ez[j0 + v] += l10[v];
+    }
+  }
+}
+
 // each batched operator compiled for every instruction-set path (src/simd_paths.hpp)
+GCFMM_DEFINE_SIMD_PATHS(void, m2p_batch_path,
+                        (const LaneState &st, const double *M, const Vec3 &c, std::size_t np, const double *x,
+                         const double *y, const double *z, double *pot, double *ex, double *ey, double *ez),
+                        m2p_batch_body, (st, M, c, np, x, y, z, pot, ex, ey, ez))
 GCFMM_DEFINE_SIMD_PATHS(void, p2m_batch_path,
                         (const LaneState &st, std::size_t np, const double *x, const double *y, const double *z,
                          const double *q, const Vec3 &c, double *M),
@@ -367,6 +413,11 @@ void Operators::symmetrize(double *a) const {
 void Operators::p2m(std::size_t np, const double *x, const double *y, const double *z, const double *q,
                     const Vec3 &c, double *M) {
   p2m_batch(np, x, y, z, q, c, M);
+}
+
+void Operators::m2p_batch(const double *M, const Vec3 &c, std::size_t np, const double *x, const double *y,
+                          const double *z, double *pot, double *ex, double *ey, double *ez) {
+  m2p_batch_path_for(path_)(lanes(), M, c, np, x, y, z, pot, ex, ey, ez);
 }
 
 void Operators::p2m_batch(std::size_t np, const double *x, const double *y, const double *z, const double *q,

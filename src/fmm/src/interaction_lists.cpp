@@ -12,14 +12,16 @@ void build_lists(const Tree &tree, const std::vector<Vec3> &shifts, double theta
 }
 
 void build_lists(const Tree &targets, const Tree &sources, const std::vector<Vec3> &shifts, double theta,
-                 double pair_limit, InteractionLists &L) {
+                 double pair_limit, InteractionLists &L, const std::vector<char> *multipole_only) {
   L.shifts = shifts;
   L.m2l.clear();
   L.p2p.clear();
+  L.m2p.clear();
   L.p2p_pairs = 0;
   const std::size_t nn = targets.nodes.size();
   L.m2l_offset.assign(nn + 1, 0);
   L.p2p_offset.assign(nn + 1, 0);
+  L.m2p_offset.assign(nn + 1, 0);
   if (nn == 0 || sources.nodes.empty()) return;
   const auto &tnodes = targets.nodes, &snodes = sources.nodes;
   const double th2 = theta * theta;
@@ -40,13 +42,17 @@ void build_lists(const Tree &targets, const Tree &sources, const std::vector<Vec
       const double d2 = dx * dx + dy * dy + dz * dz;
       const double rs = A.radius + B.radius;
       const double pairs = double(A.count()) * double(B.count());
+      // a multipole-only source lacks (some of) its particles: never P2P
+      const bool truncated = multipole_only && (*multipole_only)[b];
       if (rs * rs < th2 * d2) {
-        if (pairs <= pair_limit) {
+        if (pairs <= pair_limit && !truncated) {
           L.p2p.push_back({a, b, si});
           L.p2p_pairs += static_cast<std::size_t>(pairs);
         } else {
           L.m2l.push_back({a, b, si});
         }
+      } else if (truncated && A.leaf() && B.leaf()) {
+        L.m2p.push_back({a, b, si});
       } else if (A.leaf() && B.leaf()) {
         L.p2p.push_back({a, b, si});
         L.p2p_pairs += static_cast<std::size_t>(pairs);
@@ -68,6 +74,7 @@ void build_lists(const Tree &targets, const Tree &sources, const std::vector<Vec
   };
   sort_by_target(L.m2l, L.m2l_offset);
   sort_by_target(L.p2p, L.p2p_offset);
+  sort_by_target(L.m2p, L.m2p_offset);
 }
 
 }  // namespace gcfmm

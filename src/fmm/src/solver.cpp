@@ -27,11 +27,7 @@ void Solver::energy_potential(double *u) const {
   const Impl &I = *impl_;
   if (!I.built || !I.evaluated) throw std::runtime_error("gcfmm: energy_potential() called before evaluate()");
   if (I.n > 0 && !u) throw std::invalid_argument("gcfmm: energy_potential() got a null array");
-  const bool average = I.periodic() && I.opts.farfield == FarField::Average;
-  const auto &perm = I.tree.perm;
-  for (std::size_t i = 0; i < I.n; ++i) u[i] = 0.0;
-  for (std::size_t k = I.last_range.begin; k < I.last_range.end; ++k)
-    u[perm[k]] = I.inv_h * (average ? I.sorted_pot[k] + I.sorted_average_pot[k] : I.sorted_pot[k]);
+  I.energy_potential(u);
 }
 
 const Stats &Solver::stats() const { return impl_->stats; }
@@ -77,19 +73,9 @@ void Solver::build(std::size_t n, const double *x, const double *y, const double
   if (n > 0 && (!x || !y || !z)) throw std::invalid_argument("gcfmm: build() got a null position array");
   I.built = false;
   I.n = n;
-  Stats &s = I.stats;
-  s.t_build = timed([&] {
+  I.stats.t_build = timed([&] {
     I.build_tree(x, y, z);
-    I.build_interaction_lists();
-    I.allocate_storage();
-    I.estimate_partition_costs();
-    I.find_coincident_pairs();
-    s.levels = I.tree.levels;
-    s.nodes = I.tree.nodes.size();
-    s.leaves = I.tree.leaves.size();
-    s.m2l_count = I.lists.m2l.size();
-    s.p2p_pairs = I.lists.p2p_pairs;
-    s.estimated_error = I.res.estimated_error;
+    I.build_after_tree();
     I.setup_far_field();
   });
   I.built = true;
@@ -107,6 +93,8 @@ void Solver::evaluate(const double *q, double *pot, double *ex, double *ey, doub
   if (n > 0 && (!q || !pot || !ex || !ey || !ez)) throw std::invalid_argument("gcfmm: evaluate() got a null array");
   I.evaluated = false;
   I.sort_charges(q);
+  std::size_t first, second;
+  if (I.charged_coincident_pair(first, second)) throw coincidence_error(first, second, I.h);
   for (std::size_t i = 0; i < n; ++i) pot[i] = ex[i] = ey[i] = ez[i] = 0.0;
   Stats &s = I.stats;
   s.t_upward = s.t_m2l = s.t_p2p = s.t_downward = s.t_far = 0.0;
@@ -116,24 +104,14 @@ void Solver::evaluate(const double *q, double *pot, double *ex, double *ey, doub
 
   const TargetRange t = I.range_of(part, nparts);
   I.last_range = t;
-  for (std::size_t k = t.begin; k < t.end; ++k) I.sorted_pot[k] = I.sorted_ex[k] = I.sorted_ey[k] = I.sorted_ez[k] = 0.0;
+  I.clear_results(t);
   s.t_upward = timed([&] { I.upward(); });
   s.t_m2l = timed([&] { I.m2l(t); });
   s.t_p2p = timed([&] { I.p2p(t); });
   s.t_downward = timed([&] { I.downward(t); });
   s.t_far = timed([&] { I.far_field(t, part, nparts, sum); });
 
-  // scatter to the caller's order, back from the length unit h: pot ~ 1/length, E ~ 1/length^2
-  const auto &perm = I.tree.perm;
-  const double fp = I.inv_h, fe = I.inv_h * I.inv_h;
-  for (std::size_t k = t.begin; k < t.end; ++k) {
-    const std::size_t i = perm[k];
-    pot[i] = fp * I.sorted_pot[k];
-    ex[i] = fe * I.sorted_ex[k];
-    ey[i] = fe * I.sorted_ey[k];
-    ez[i] = fe * I.sorted_ez[k];
-  }
+  I.scatter(t, pot, ex, ey, ez);
 }
 
 }  // namespace gcfmm
-

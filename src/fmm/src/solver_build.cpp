@@ -11,23 +11,31 @@ using namespace detail;
 // Positions of a periodic system are wrapped into the primary cell first; all positions are
 // then expressed in the length unit h (the cell's for Periodic2D, the particles' extent in
 // free space), so the tree, the lists and the expansions see coordinates of order 1.
-void Solver::Impl::build_tree(const double *x, const double *y, const double *z) {
-  if (periodic()) {
-    h = length_unit(std::max(lx, ly));
-  } else {
-    double extent = 0.0;
-    if (n > 0)
-      for (const double *c : {x, y, z}) {
-        const auto [lo, hi] = std::minmax_element(c, c + n);
-        extent = std::max(extent, *hi - *lo);
-      }
-    h = length_unit(extent);
-  }
+void SolverCore::build_tree(const double *x, const double *y, const double *z) {
+  choose_length_unit(x, y, z);
+  build_scaled_tree(x, y, z);
+}
+
+void SolverCore::choose_length_unit(const double *x, const double *y, const double *z) {
+  double extent = 0.0;
+  if (!periodic() && n > 0)
+    for (const double *c : {x, y, z}) {
+      const auto [lo, hi] = std::minmax_element(c, c + n);
+      extent = std::max(extent, *hi - *lo);
+    }
+  set_length_unit(periodic() ? length_unit(std::max(lx, ly)) : length_unit(extent));
+}
+
+void SolverCore::set_length_unit(double unit) {
+  h = unit;
   inv_h = 1.0 / h;
   sx0 = x0 * inv_h;
   sy0 = y0 * inv_h;
   slx = lx * inv_h;
   sly = ly * inv_h;
+}
+
+void SolverCore::build_scaled_tree(const double *x, const double *y, const double *z) {
   scaled_x.resize(n);
   scaled_y.resize(n);
   scaled_z.resize(n);
@@ -45,20 +53,27 @@ void Solver::Impl::build_tree(const double *x, const double *y, const double *z)
   }
 }
 
-// The source tree shifted by every image shift of the near block (doc/theory.md, eq. (4.1)).
-void Solver::Impl::build_interaction_lists() {
-  std::vector<Vec3> shifts;
-  if (periodic()) {
-    const int k = opts.images;
-    for (int nx = -k; nx <= k; ++nx)
-      for (int ny = -k; ny <= k; ++ny) shifts.push_back({nx * slx, ny * sly, 0.0});
-  } else {
-    shifts.push_back({0.0, 0.0, 0.0});
-  }
-  build_lists(tree, shifts, res.theta, m2l_cost(res.order, ops->simd_path()), lists);
+// The phases of build() after the tree but the far field, with the stats they determine.
+void SolverCore::build_after_tree() {
+  build_interaction_lists();
+  allocate_storage();
+  estimate_partition_costs();
+  find_coincident_pairs();
+  stats.levels = tree.levels;
+  stats.nodes = tree.nodes.size();
+  stats.leaves = tree.leaves.size();
+  stats.m2l_count = lists.m2l.size();
+  stats.p2p_pairs = lists.p2p_pairs;
+  stats.estimated_error = res.estimated_error;
 }
 
-void Solver::Impl::allocate_storage() {
+// The source tree shifted by every image shift of the near block (doc/theory.md, eq. (4.1)).
+void SolverCore::build_interaction_lists() {
+  build_lists(tree, image_shifts(periodic(), opts.images, slx, sly), res.theta, m2l_cost(res.order, ops->simd_path()),
+              lists);
+}
+
+void SolverCore::allocate_storage() {
   const std::size_t nn = tree.nodes.size();
   multipole.assign(nn * expansion_size(), 0.0);
   local.assign(nn * expansion_size(), 0.0);
@@ -73,7 +88,7 @@ void Solver::Impl::allocate_storage() {
 
 // Estimated cost per particle (eq. (3.16)), summed over leaves: the work partitions cut this
 // prefix sum into equal parts.
-void Solver::Impl::estimate_partition_costs() {
+void SolverCore::estimate_partition_costs() {
   // cost per particle of each node's own list entries, then summed down the tree (a
   // particle pays for the entries of every node that contains it; parents come first)
   const int p = res.order;
@@ -100,7 +115,7 @@ void Solver::Impl::estimate_partition_costs() {
 // so that lattice-aligned inputs with many particles on cube faces stay O(k log k).
 // (An M2L pair of nodes that close would need nodes smaller than r holding more particles than
 // the P2P threshold (3.16): coincident pairs inside them, found here, as well.)
-void Solver::Impl::find_coincident_pairs() {
+void SolverCore::find_coincident_pairs() {
   coincident.clear();
   const auto &xs = tree.xs, &ys = tree.ys, &zs = tree.zs;
   const double r = kCoincidenceRadius, r2 = r * r;
@@ -159,7 +174,7 @@ void Solver::Impl::find_coincident_pairs() {
   coincident.erase(std::unique(coincident.begin(), coincident.end()), coincident.end());
 }
 
-void Solver::Impl::setup_far_field() {
+void SolverCore::setup_far_field() {
   if (!periodic() || opts.farfield != FarField::Exact) return;
   // the lattice sum accepts accuracies down to 1e-8 (its far field is smooth and tiny anyway)
   const double facc = std::max(opts.accuracy, 1e-8);

@@ -5,8 +5,9 @@
 //               -> coincident pairs -> far-field set-up                  (solver_build.cpp)
 //   evaluate(): sort charges -> upward (P2M, M2M) -> M2L -> P2P -> downward (L2L, L2P)
 //               -> far field -> scatter to the caller's order             (solver_evaluate.cpp)
-// Each phase is one member function of Solver::Impl; the phases of evaluate() are the units
-// for threading.
+// Each phase is one member function of detail::SolverCore (Solver::Impl is exactly that); the
+// phases of evaluate() are the units for threading. DistributedSolver runs the same phases on
+// its rank's particles and adds the remote part between them (src/distributed_impl.hpp).
 #ifndef GCFMM_SOLVER_IMPL_HPP
 #define GCFMM_SOLVER_IMPL_HPP
 
@@ -89,6 +90,17 @@ inline void upward_pass(const Tree &tree, const double *q, Operators &ops, std::
   }
 }
 
+// The bed z range [blo, bhi] of the average far field made a slab: a flat layer (e.g. one
+// charged particle) becomes a slab of thickness 1e-6 min(slx, sly) (relative change of the far
+// field ~1e-6).
+inline void thicken_bed(double slx, double sly, double &blo, double &bhi) {
+  if (!(bhi - blo > 1e-6 * std::min(slx, sly))) {
+    const double mid = 0.5 * (blo + bhi), half = 0.5e-6 * std::min(slx, sly);
+    blo = mid - half;
+    bhi = mid + half;
+  }
+}
+
 // The bed of the average far field (doc/theory.md, eq. (4.7)) in units of h: Options::bed_zlo
 // and bed_zhi if given, else the z range of the charged particles (zs, q: n particles in units
 // of h); a flat layer (e.g. one charged particle) becomes a slab of thickness 1e-6 min(slx, sly)
@@ -108,12 +120,22 @@ inline bool average_bed(const Options &o, double inv_h, std::size_t n, const dou
       }
     if (!any) return false;
   }
-  if (!(bhi - blo > 1e-6 * std::min(slx, sly))) {
-    const double mid = 0.5 * (blo + bhi), half = 0.5e-6 * std::min(slx, sly);
-    blo = mid - half;
-    bhi = mid + half;
-  }
+  thicken_bed(slx, sly, blo, bhi);
   return true;
+}
+
+// bytes held by a tree and by interaction lists (memory statistics)
+template <class T>
+inline std::size_t vector_bytes(const std::vector<T> &v) {
+  return v.capacity() * sizeof(T);
+}
+inline std::size_t tree_bytes(const Tree &t) {
+  return vector_bytes(t.nodes) + vector_bytes(t.cubes) + vector_bytes(t.perm) + vector_bytes(t.xs) +
+         vector_bytes(t.ys) + vector_bytes(t.zs) + vector_bytes(t.leaves);
+}
+inline std::size_t lists_bytes(const InteractionLists &l) {
+  return vector_bytes(l.shifts) + vector_bytes(l.m2l) + vector_bytes(l.p2p) + vector_bytes(l.m2p) +
+         vector_bytes(l.m2l_offset) + vector_bytes(l.p2p_offset) + vector_bytes(l.m2p_offset);
 }
 
 //! The targets of one work partition: sorted particle indices [begin, end).
@@ -124,9 +146,65 @@ struct TargetRange {
   std::size_t last(const Node &A) const { return std::min<std::size_t>(A.end, end); }
 };
 
-}  // namespace detail
+// the error of two coincident particles (ids or indices i < j) at the length unit h
+inline CoincidentParticles coincidence_error(std::size_t i, std::size_t j, double h) {
+  return CoincidentParticles(i, j, "gcfmm: particles " + std::to_string(i) + " and " + std::to_string(j) +
+                                       " are at the same position (closer than " +
+                                       std::to_string(kCoincidenceRadius * h) + ")");
+}
 
-struct Solver::Impl {
+// The shifts of the source tree for the near block (doc/theory.md, eq. (4.1)): (2 images + 1)^2
+// lattice vectors of the cell (slx, sly) for Periodic2D, the single shift 0 in free space.
+inline std::vector<Vec3> image_shifts(bool periodic, int images, double slx, double sly) {
+  std::vector<Vec3> shifts;
+  if (periodic) {
+    for (int nx = -images; nx <= images; ++nx)
+      for (int ny = -images; ny <= images; ++ny) shifts.push_back({nx * slx, ny * sly, 0.0});
+  } else {
+    shifts.push_back({0.0, 0.0, 0.0});
+  }
+  return shifts;
+}
+
+// M2L (eq. (3.11)) of the list entries [e0, e1) of one target node A into its local expansion
+// Li (added), the sources being `snodes` with multipoles `smultipole` (ops.size() doubles per
+// node); batch_m, batch_r are scratch of at least e1 - e0 entries.
+inline void m2l_entries(Operators &ops, const Node &A, const InteractionLists &lists, std::uint32_t e0,
+                        std::uint32_t e1, const std::vector<Node> &snodes, const double *smultipole,
+                        std::vector<const double *> &batch_m, std::vector<Vec3> &batch_r, double *Li) {
+  if (e1 == e0) return;
+  if (batch_m.size() < e1 - e0) {
+    batch_m.resize(e1 - e0);
+    batch_r.resize(e1 - e0);
+  }
+  for (std::uint32_t e = e0; e < e1; ++e) {
+    const Interaction &it = lists.m2l[e];
+    const Node &B = snodes[it.source];
+    batch_m[e - e0] = smultipole + it.source * ops.size();
+    batch_r[e - e0] = A.center - (B.center + lists.shifts[it.shift]);
+  }
+  ops.m2l_batch(e1 - e0, batch_m.data(), batch_r.data(), Li);
+}
+
+// P2P (eq. (3.1)) of the list entries of target node i at its targets [a, b) (tree order of the
+// target arrays tx, ty, tz; results added to pot, ex, ey, ez at the same indices), the sources
+// being the node ranges of `snodes` in the arrays sx, sy, sz, sq.
+inline void p2p_entries(const InteractionLists &lists, std::size_t i, std::size_t a, std::size_t b, const double *tx,
+                        const double *ty, const double *tz, const std::vector<Node> &snodes, const double *sx,
+                        const double *sy, const double *sz, const double *sq, double *pot, double *ex, double *ey,
+                        double *ez) {
+  for (std::uint32_t e = lists.p2p_offset[i]; e < lists.p2p_offset[i + 1]; ++e) {
+    const Interaction &it = lists.p2p[e];
+    const Node &B = snodes[it.source];
+    const Vec3 &sh = lists.shifts[it.shift];
+    gcfmm::p2p(b - a, tx + a, ty + a, tz + a, B.count(), sx + B.begin, sy + B.begin, sz + B.begin, sq + B.begin, sh.x,
+               sh.y, sh.z, pot + a, ex + a, ey + a, ez + a, kCoincidenceRadius * kCoincidenceRadius);
+  }
+}
+
+//! The state and phases of one solver over one set of particles (Solver::Impl; one rank's
+//! particles in DistributedSolver).
+struct SolverCore {
   Options opts;
   Resolved res;
   Stats stats;
@@ -179,6 +257,13 @@ struct Solver::Impl {
 
   // ---- build phases ----
   void build_tree(const double *x, const double *y, const double *z);
+  // the two halves of build_tree(): h from the particles' extent (free) or the cell, then the
+  // tree over the wrapped positions in units of h
+  void choose_length_unit(const double *x, const double *y, const double *z);
+  void set_length_unit(double unit);
+  void build_scaled_tree(const double *x, const double *y, const double *z);
+  // the phases of build() after build_tree() but setup_far_field()
+  void build_after_tree();
   void build_interaction_lists();
   void allocate_storage();
   void estimate_partition_costs();
@@ -192,12 +277,27 @@ struct Solver::Impl {
       if (t.hits(tree.nodes[i])) f(i, tree.nodes[i]);
   }
   void sort_charges(const double *q);
+  // the first coincident pair with a charge, as input indices i < j; false if none
+  bool charged_coincident_pair(std::size_t &i, std::size_t &j) const;
+  // zero the sorted results of the targets t
+  void clear_results(const detail::TargetRange &t);
   void upward();
   void m2l(const detail::TargetRange &t);
   void p2p(const detail::TargetRange &t);
   void downward(const detail::TargetRange &t);
   void far_field(const detail::TargetRange &t, int part, int nparts, const PartSum &sum);
+  // the average far field of a total charge qsum per cell in the bed [blo, bhi] (units of h) at
+  // the targets t, its potential also kept apart for energy_potential()
+  void add_average_far_field(double qsum, double blo, double bhi, const detail::TargetRange &t);
+  // the results of the targets t in the caller's order, back from the length unit h
+  void scatter(const detail::TargetRange &t, double *pot, double *ex, double *ey, double *ez) const;
+  // energy_potential() of the last evaluate() (solver.hpp)
+  void energy_potential(double *u) const;
 };
+
+}  // namespace detail
+
+struct Solver::Impl : detail::SolverCore {};
 
 }  // namespace gcfmm
 

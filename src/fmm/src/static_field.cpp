@@ -482,23 +482,12 @@ std::size_t StaticSourceField::memory_bytes() const {
   const Impl &I = *impl_;
   std::size_t b = 0;
   auto vec = [&b](const auto &v) { b += v.capacity() * sizeof(v[0]); };
-  for (const Tree *t : {&I.stree, &I.ttree}) {
-    vec(t->nodes);
-    vec(t->cubes);
-    vec(t->perm);
-    vec(t->xs);
-    vec(t->ys);
-    vec(t->zs);
-    vec(t->leaves);
-  }
+  b += tree_bytes(I.stree) + tree_bytes(I.ttree);
   vec(I.src_index);
   for (const auto *v : {&I.cx, &I.cy, &I.cz, &I.cq, &I.sq, &I.multipole, &I.phi, &I.tx, &I.ty, &I.tz, &I.local,
                         &I.tpot, &I.tex, &I.tey, &I.tez})
     vec(*v);
-  vec(I.lists.m2l);
-  vec(I.lists.p2p);
-  vec(I.lists.m2l_offset);
-  vec(I.lists.p2p_offset);
+  b += lists_bytes(I.lists);
   vec(I.has_local);
   vec(I.batch_m);
   vec(I.batch_r);

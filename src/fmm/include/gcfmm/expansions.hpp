@@ -89,6 +89,14 @@ class Operators {
                  double *pot, double *ex, double *ey, double *ez);
   /** M2P (for tests): potential of the (full) multipole at r = x - z_s (doc/theory.md, eq. (3.8)). */
   double m2p_potential(const double *M, const Vec3 &r);
+  /** Batched M2P: adds the potential and field E = -grad phi of the (full) multipole about c
+   *  at the n points (x, y, z)[0..n), kBatch points per SIMD lane; it is M2L (doc/theory.md,
+   *  eq. (3.11)) to a local expansion about the point itself, of which only L_0^0 (the
+   *  potential, eq. (3.8)) and L_1^m (the field, eq. (3.13) at r = 0) are formed: O(p^2) per
+   *  point, with the same truncation (n + k <= p) as M2L + L2P. Lanes never mix.
+   *  @pre every point outside the multipole's sphere (convergence: r_s < theta |x - c|). */
+  void m2p_batch(const double *M, const Vec3 &c, std::size_t n, const double *x, const double *y, const double *z,
+                 double *pot, double *ex, double *ey, double *ez);
 
  private:
   detail::LaneState lanes();

@@ -8,6 +8,11 @@
 // M2L, unless n_A n_B <= pair_limit, where the direct sum is cheaper (then P2P). Rejected
 // pairs split the node with the larger radius (a leaf is never split); two rejected leaves
 // become P2P. Every (target particle, source particle, shift) triple is covered exactly once.
+// Optionally some source nodes are "multipole only" (in a local essential tree,
+// doc/fmm-distributed.md: a truncated node, whose multipole is known but not its particles, or
+// a node with a truncated descendant, whose particle range is incomplete): an accepted pair
+// with such a source is always M2L, a rejected pair (target leaf, such a source leaf) is M2P,
+// and such an internal source is split as any other.
 #ifndef GCFMM_INTERACTION_LISTS_HPP
 #define GCFMM_INTERACTION_LISTS_HPP
 
@@ -33,6 +38,9 @@ struct InteractionLists {
   std::vector<Interaction> p2p;           //!< direct interactions (node ranges)
   std::vector<std::uint32_t> m2l_offset;  //!< entries of node i: m2l[m2l_offset[i] .. m2l_offset[i+1])
   std::vector<std::uint32_t> p2p_offset;  //!< entries of node i: p2p[p2p_offset[i] .. p2p_offset[i+1])
+  std::vector<Interaction> m2p;           //!< multipole evaluated at each particle of a target leaf
+                                          //!< (only with multipole-only sources, else empty)
+  std::vector<std::uint32_t> m2p_offset;  //!< entries of node i: m2p[m2p_offset[i] .. m2p_offset[i+1])
   std::size_t p2p_pairs = 0;              //!< number of particle pairs in the P2P list
 };
 
@@ -47,12 +55,21 @@ void build_lists(const Tree &tree, const std::vector<Vec3> &shifts, double theta
                  InteractionLists &lists);
 
 /** @brief The same traversal between two trees: the targets' tree against the sources' tree
- *  shifted by each shift (StaticSourceField). Interaction::target indexes `targets`' nodes,
- *  Interaction::source `sources`' nodes; the offsets are over the target nodes. Nothing is
- *  assumed about where the targets lie relative to the sources. Either tree may be empty
- *  (no entries). */
+ *  shifted by each shift (StaticSourceField, DistributedSolver). Interaction::target indexes
+ *  `targets`' nodes, Interaction::source `sources`' nodes; the offsets are over the target
+ *  nodes. Nothing is assumed about where the targets lie relative to the sources. Either tree
+ *  may be empty (no entries).
+ *  @param multipole_only null (every source node has all its particles: the lists are
+ *         exactly those of the two-tree traversal above, m2p empty) or one flag per source
+ *         node, set where the node's particle range lacks some of its particles (its multipole
+ *         is complete). Accepted pairs with a flagged source go to M2L whatever pair_limit
+ *         says; rejected ones are split as usual, and a rejected pair of a target leaf and a
+ *         flagged source leaf goes to the M2P list. The caller must make sure the multipole
+ *         converges at those target particles (point MAC r_B < theta |x - c_B - s|, guaranteed
+ *         by the LET criterion of doc/fmm-distributed.md) and flag every ancestor of a flagged
+ *         node too. */
 void build_lists(const Tree &targets, const Tree &sources, const std::vector<Vec3> &shifts, double theta,
-                 double pair_limit, InteractionLists &lists);
+                 double pair_limit, InteractionLists &lists, const std::vector<char> *multipole_only = nullptr);
 
 }  // namespace gcfmm
 
