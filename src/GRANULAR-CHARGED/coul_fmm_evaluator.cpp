@@ -24,6 +24,7 @@
 #include "pair.h"
 #include "update.h"
 
+#include "gcfmm/distributed_solver.hpp"
 #include "gcfmm/far_field.hpp"
 #include "gcfmm/options.hpp"
 #include "gcfmm/solver.hpp"
@@ -41,8 +42,9 @@ struct SleeperCoincidence {
 }    // namespace
 
 CoulFMMEvaluator::CoulFMMEvaluator(LAMMPS *lmp, const std::string &id, int bit) :
-    Pointers(lmp), fix_id(id), groupbit(bit), opts(new gcfmm::Options), solver_boundary(-1),
-    mpi(lmp), fresh(nullptr), nmax_fresh(0), sleep_fix(nullptr), pair_energy(0.0), logged(false)
+    Pointers(lmp), fix_id(id), groupbit(bit), opts(new gcfmm::Options), distributed(false),
+    solver_boundary(-1), mpi(lmp), fresh(nullptr), nmax_fresh(0), sleep_fix(nullptr),
+    pair_energy(0.0), logged(false)
 {
 }
 
@@ -119,7 +121,8 @@ void CoulFMMEvaluator::check_counted_once(Fix *self)
   }
 }
 
-void CoulFMMEvaluator::init(const gcfmm::Options &options, FixSleepGran *sleep, bool virial)
+void CoulFMMEvaluator::init(const gcfmm::Options &options, FixSleepGran *sleep, bool virial,
+                            bool distribute)
 {
   *opts = options;
   if (sleep && opts->boundary == gcfmm::Boundary::Periodic2D &&
@@ -137,9 +140,18 @@ void CoulFMMEvaluator::init(const gcfmm::Options &options, FixSleepGran *sleep, 
                fix_id, sleep->id, fix_id);
   // the solver (tree memory, far-field operator) is kept across runs; the boundary is the only
   // option init() can change
-  const bool solver_new = !solver || solver_boundary != (int) opts->boundary;
+  const bool solver_new = solver_boundary != (int) opts->boundary || distribute != distributed ||
+      (!solver && !distributed_solver);
+  distributed = distribute;
   try {
-    if (solver_new) solver = std::make_unique<gcfmm::Solver>(*opts);
+    if (solver_new) {
+      solver.reset();
+      distributed_solver.reset();
+      if (distributed)
+        distributed_solver = std::make_unique<gcfmm::DistributedSolver>(*opts, mpi.collectives);
+      else
+        solver = std::make_unique<gcfmm::Solver>(*opts);
+    }
     if (!sleep)
       sleepers.reset();
     else if (solver_new || !sleepers)
@@ -243,15 +255,7 @@ void CoulFMMEvaluator::evaluate(double **out, int col, bool split)
 {
   update_sleepers();
   split = split && split_active();
-  int *mask = atom->mask;
-  double *q = atom->q;
-  mpi.gather(
-      [&](int i) {
-        return (mask[i] & groupbit) && q[i] != 0.0 && !(split && asleep(i));
-      },
-      gathered);
-  const int nlocal = atom->nlocal;
-  for (int i = 0; i < nlocal; i++)
+  for (int i = 0; i < atom->nlocal; i++)
     for (int k = 0; k < 4; k++) out[i][col + k] = 0.0;
   if (split) {
     pair_energy = 0.0;    // a full evaluation (keyword check) keeps the split's
@@ -267,101 +271,231 @@ void CoulFMMEvaluator::evaluate(double **out, int col, bool split)
       error->all(FLERR, "Fix coul/fmm: FMM library (static sleepers): {}", e.what());
     }
   }
-  if (gathered.size() == 0) return;
+  int *mask = atom->mask;
+  double *q = atom->q;
+  auto charged = [&](int i) {
+    return (mask[i] & groupbit) && q[i] != 0.0 && !(split && asleep(i));
+  };
+  const bool done = distributed ? evaluate_distributed(charged, out, col, split)
+                                : evaluate_replicated(charged, out, col, split);
+  if (!done) return;
+  record_diagnostics();
+  log_parameters();
+}
 
-  // a failure may be seen by one rank only (it owns the offending targets): agree on it
-  const std::string failure = mpi.first_failure(solve(split));
+/* ----------------------------------------------------------------------
+   every rank holds all charges (sorted by atom ID: the same tree everywhere, results bit for
+   bit independent of the rank count) and computes its share of the targets
+------------------------------------------------------------------------- */
+
+bool CoulFMMEvaluator::evaluate_replicated(const std::function<bool(int)> &charged, double **out,
+                                           int col, bool split)
+{
+  mpi.gather(charged, gathered);
+  const size_t n = gathered.size();
+  if (n == 0) return false;
+  result.assign(4 * n, 0.0);
+  double *pot = result.data(), *ex = pot + n, *ey = pot + 2 * n, *ez = pot + 3 * n;
+  double qpot = 0.0;    // sum q pot^sleepers over this rank's share
+  const std::string failure = mpi.first_failure(guarded(
+      [&] {
+        if (opts->boundary == gcfmm::Boundary::Periodic2D) {
+          solver->set_box(domain->boxlo[0], domain->boxlo[1], domain->xprd, domain->yprd);
+          // boundary f in z keeps every atom in the box: one far-field set-up for the run
+          // instead of one each time the charges' z range grows (e.g. during a deposition)
+          solver->set_z_range(domain->boxlo[2], domain->boxhi[2]);
+        }
+        solver->build(n, gathered.x.data(), gathered.y.data(), gathered.z.data());
+        // the ranks share the far field's anterpolation, which every one of them would
+        // otherwise repeat: each computes its share, one in-place sum completes it (exact)
+        const gcfmm::PartSum sum = [this](double *data, std::size_t count) {
+          mpi.collectives.allreduce_sum(data, count);
+        };
+        solver->evaluate(gathered.q.data(), pot, ex, ey, ez, comm->me, comm->nprocs, sum);
+        // the potential whose energy 1/2 sum q_i u_i has minus the applied forces as gradient
+        // (differs from pot only for farfield average; doc/theory.md, eq. (4.10))
+        solver->energy_potential(pot);
+        // the sleepers' field at this rank's share of the awake targets (the return to the
+        // owners sums the shares; the solver's own parts are disjoint the same way)
+        const size_t first = n * comm->me / comm->nprocs, last = n * (comm->me + 1) / comm->nprocs;
+        if (split) qpot = add_sleepers_field(gathered, first, last, pot, ex, ey, ez);
+      },
+      [&](size_t k) {
+        return gathered.tag[k];
+      }));
   if (!failure.empty())
     error->all(FLERR, Error::NOLASTLINE, "Fix coul/fmm: FMM library: {}", failure);
+  if (split) sum_pair_energy(qpot);
 
+  values.resize(4 * n);
+  for (size_t k = 0; k < n; k++) {
+    const double v[4] = {ex[k], ey[k], ez[k], pot[k]};
+    std::copy(v, v + 4, &values[4 * k]);
+  }
   mpi.return_to_owners(gathered, values, mine);
   // the received block is in the order gather() took this rank's atoms;
   // bare 1/r kernel -> LAMMPS units: qqrd2e includes the dielectric constant
   const double c = force->qqrd2e;
   size_t m = 0;
-  for (int i = 0; i < nlocal; i++) {
-    if (!(mask[i] & groupbit) || q[i] == 0.0 || (split && asleep(i))) continue;
+  for (int i = 0; i < atom->nlocal; i++) {
+    if (!charged(i)) continue;
     for (int k = 0; k < 4; k++) out[i][col + k] = c * mine[4 * m + k];
     m++;
   }
-  log_parameters();
+  return true;
 }
 
 /* ----------------------------------------------------------------------
-   the solver on the gathered charges, this rank's share of the targets into `values` (Ex, Ey,
-   Ez, phi per gathered atom, zero for the other ranks' shares); returns "" or what failed
+   every rank keeps its own charges: gcfmm::DistributedSolver exchanges the local essential
+   trees (doc/fmm-distributed.md) through CoulFMMComm
 ------------------------------------------------------------------------- */
 
-std::string CoulFMMEvaluator::solve(bool split)
+bool CoulFMMEvaluator::evaluate_distributed(const std::function<bool(int)> &charged, double **out,
+                                            int col, bool split)
 {
-  const size_t n = gathered.size();
+  double **x = atom->x;
+  local.x.clear();
+  local.y.clear();
+  local.z.clear();
+  local.q.clear();
+  local.tag.clear();
+  ids.clear();
+  for (int i = 0; i < atom->nlocal; i++) {
+    if (!charged(i)) continue;
+    local.x.push_back(x[i][0]);
+    local.y.push_back(x[i][1]);
+    local.z.push_back(x[i][2]);
+    local.q.push_back(atom->q[i]);
+    local.tag.push_back(atom->tag[i]);
+    ids.push_back((int64_t) atom->tag[i]);
+  }
+  const size_t n = local.size();
+  double total = (double) n;
+  mpi.sum(&total, 1);
+  if (total == 0.0) return false;
   result.assign(4 * n, 0.0);
   double *pot = result.data(), *ex = pot + n, *ey = pot + 2 * n, *ez = pot + 3 * n;
-  double qpot = 0.0;    // sum q pot^sleepers over this rank's share
-  std::string failure;
+  double qpot = 0.0;
+  const std::string failure = mpi.first_failure(guarded(
+      [&] {
+        if (opts->boundary == gcfmm::Boundary::Periodic2D) {
+          distributed_solver->set_box(domain->boxlo[0], domain->boxlo[1], domain->xprd,
+                                      domain->yprd);
+          distributed_solver->set_z_range(domain->boxlo[2], domain->boxhi[2]);
+        }
+        distributed_solver->evaluate(n, local.x.data(), local.y.data(), local.z.data(),
+                                     local.q.data(), ids.data(), pot, ex, ey, ez);
+        distributed_solver->energy_potential(pot);
+        if (split) qpot = add_sleepers_field(local, 0, n, pot, ex, ey, ez);
+      },
+      // DistributedSolver reports the ids it was given: the atom IDs
+      [&](size_t id) {
+        return (tagint) id;
+      }));
+  if (!failure.empty())
+    error->all(FLERR, Error::NOLASTLINE, "Fix coul/fmm: FMM library: {}", failure);
+  if (split) sum_pair_energy(qpot);
+  const double c = force->qqrd2e;
+  size_t m = 0;
+  for (int i = 0; i < atom->nlocal; i++) {
+    if (!charged(i)) continue;
+    const double v[4] = {ex[m], ey[m], ez[m], pot[m]};
+    for (int k = 0; k < 4; k++) out[i][col + k] = c * v[k];
+    m++;
+  }
+  return true;
+}
+
+// ADD the sleepers' field at the targets [first, last) of `targets`; sum q pot^sleepers there
+double CoulFMMEvaluator::add_sleepers_field(const GatheredCharges &targets, size_t first,
+                                            size_t last, double *pot, double *ex, double *ey,
+                                            double *ez)
+{
   try {
-    if (opts->boundary == gcfmm::Boundary::Periodic2D) {
-      solver->set_box(domain->boxlo[0], domain->boxlo[1], domain->xprd, domain->yprd);
-      // with boundary f in z every atom stays in the box: one far-field set-up for the run
-      // instead of one each time the charges' z range grows (e.g. during a deposition)
-      solver->set_z_range(domain->boxlo[2], domain->boxhi[2]);
-    }
-    solver->build(n, gathered.x.data(), gathered.y.data(), gathered.z.data());
-    // the ranks share the far field's anterpolation, which every one of them would otherwise
-    // repeat: each computes its share, one in-place sum completes it (exact)
-    const gcfmm::PartSum sum = [this](double *data, std::size_t count) {
-      mpi.sum(data, (int) count);
-    };
-    solver->evaluate(gathered.q.data(), pot, ex, ey, ez, comm->me, comm->nprocs, sum);
-    // the potential whose energy 1/2 sum q_i u_i has minus the applied forces as gradient
-    // (differs from pot only for farfield average; doc/theory.md, eq. (4.10))
-    solver->energy_potential(pot);
-    if (split) {
-      // the sleepers' field at this rank's share of the awake targets (the return to the
-      // owners sums the shares; the solver's own parts are disjoint the same way)
-      const size_t first = n * comm->me / comm->nprocs, last = n * (comm->me + 1) / comm->nprocs;
-      try {
-        qpot = sleepers->add_field(gathered.x.data(), gathered.y.data(), gathered.z.data(),
-                                   gathered.q.data(), first, last, pot, ex, ey, ez);
-      } catch (gcfmm::CoincidentParticles &e) {
-        throw SleeperCoincidence{fmt::format(
-            "atom {} is at the position of the sleeping atom {} (closer than {:g} of the "
-            "solver's length unit): their Coulomb force is not defined",
-            gathered.tag[first + e.first()], sleepers->source_tag(e.second()),
-            gcfmm::kCoincidenceRadius)};
-      }
-    }
-  } catch (SleeperCoincidence &e) {
-    failure = e.message;
+    return sleepers->add_field(targets.x.data(), targets.y.data(), targets.z.data(),
+                               targets.q.data(), first, last, pot, ex, ey, ez);
   } catch (gcfmm::CoincidentParticles &e) {
-    failure =
-        fmt::format("atoms {} and {} are at the same position (closer than {:g} of the "
-                    "solver's length unit): their Coulomb force is not defined",
-                    gathered.tag[e.first()], gathered.tag[e.second()], gcfmm::kCoincidenceRadius);
+    throw SleeperCoincidence{
+        fmt::format("atom {} is at the position of the sleeping atom {} (closer than {:g} of "
+                    "the solver's length unit): their Coulomb force is not defined",
+                    targets.tag[first + e.first()], sleepers->source_tag(e.second()),
+                    gcfmm::kCoincidenceRadius)};
+  }
+}
+
+void CoulFMMEvaluator::sum_pair_energy(double qpot)
+{
+  mpi.sum(&qpot, 1);
+  pair_energy = 0.5 * force->qqrd2e * qpot;
+}
+
+// run the solver; "" or what failed, in LAMMPS terms (tag_of: an index of the solver's
+// CoincidentParticles -> atom ID)
+std::string CoulFMMEvaluator::guarded(const std::function<void()> &run,
+                                      const std::function<tagint(size_t)> &tag_of)
+{
+  try {
+    run();
+  } catch (SleeperCoincidence &e) {
+    return e.message;
+  } catch (gcfmm::CoincidentParticles &e) {
+    return fmt::format("atoms {} and {} are at the same position (closer than {:g} of the "
+                       "solver's length unit): their Coulomb force is not defined",
+                       tag_of(e.first()), tag_of(e.second()), gcfmm::kCoincidenceRadius);
   } catch (gcfmm::FarFieldTooLarge &e) {
     // the column's height (box or charges) sets the cost of the exact far field
-    failure = fmt::format("{}. In LAMMPS terms: the charged column (or the box in z, with "
-                          "boundary p p f) is {:.3g} times the cell side; use farfield average or "
-                          "none, a box or a wall that keeps the particles lower (a lid), or "
-                          "remove escaping particles (e.g. fix evaporate)",
-                          e.what(), e.height_over_side());
+    return fmt::format("{}. In LAMMPS terms: the charged column (or the box in z, with "
+                       "boundary p p f) is {:.3g} times the cell side; use farfield average or "
+                       "none, a box or a wall that keeps the particles lower (a lid), or "
+                       "remove escaping particles (e.g. fix evaporate)",
+                       e.what(), e.height_over_side());
   } catch (std::exception &e) {
-    failure = e.what();
-    if (failure.empty()) failure = "unknown error";
+    const std::string what = e.what();
+    return what.empty() ? "unknown error" : what;
   }
-  if (split) {
-    mpi.sum(&qpot, 1);
-    pair_energy = 0.5 * force->qqrd2e * qpot;
+  return "";
+}
+
+/* ----------------------------------------------------------------------
+   the global vector's solver elements of the last evaluation, the same on every rank: the
+   parameters, M2L and P2P counts (all ranks), the largest bytes received by a rank (all of
+   this evaluation's collectives) and the largest solver memory of a rank
+------------------------------------------------------------------------- */
+
+void CoulFMMEvaluator::record_diagnostics()
+{
+  double sums[2], maxima[2] = {mpi.collectives.take_received_bytes(), 0.0};
+  if (distributed) {
+    const auto &st = distributed_solver->stats();
+    diagnostics.estimated_error = st.estimated_error;
+    diagnostics.order = st.order;
+    diagnostics.theta = st.theta;
+    diagnostics.leaf = st.leaf;
+    sums[0] = (double) st.m2l_count;
+    sums[1] = (double) st.p2p_pairs;
+    maxima[1] = (double) st.memory_bytes;
+    mpi.sum(sums, 2);
+  } else {
+    const auto &st = solver->stats();
+    diagnostics.estimated_error = st.estimated_error;
+    diagnostics.order = st.order;
+    diagnostics.theta = st.theta;
+    diagnostics.leaf = st.leaf;
+    sums[0] = (double) st.m2l_count;    // the whole evaluation's, on every rank
+    sums[1] = (double) st.p2p_pairs;
+    maxima[1] = (double) solver->memory_bytes();
   }
-  values.resize(4 * n);
-  for (size_t k = 0; k < n; k++) {
-    double *slot = &values[4 * k];
-    slot[0] = ex[k];
-    slot[1] = ey[k];
-    slot[2] = ez[k];
-    slot[3] = pot[k];
+  mpi.collectives.allreduce_max(maxima, 2);
+  mpi.collectives.take_received_bytes();    // the diagnostics' own reduction is not the evaluation's
+  diagnostics.m2l = sums[0];
+  diagnostics.p2p = sums[1];
+  diagnostics.bytes_received = maxima[0];
+  diagnostics.solver_memory = maxima[1];
+  diagnostics.charges = distributed ? 0.0 : (double) gathered.size();
+  if (distributed) {
+    diagnostics.charges = (double) local.size();
+    mpi.sum(&diagnostics.charges, 1);
   }
-  return failure;
 }
 
 void CoulFMMEvaluator::log_parameters()
@@ -369,19 +503,21 @@ void CoulFMMEvaluator::log_parameters()
   if (logged) return;
   logged = true;
   if (comm->me != 0) return;
-  const auto &st = solver->stats();
   static const char *ffname[] = {"none", "average", "exact"};
   const bool free_space = opts->boundary == gcfmm::Boundary::Free;
+  const auto &d = diagnostics;
   utils::logmesg(lmp,
-                 "FMM Coulomb (fix coul/fmm {}): {} charged atoms, {}\n"
-                 "  order = {}, theta = {:.3g}, leaf = {}, levels = {}{}\n"
-                 "  estimated relative RMS force error = {:.3g} (requested accuracy {:.3g})\n",
-                 fix_id, gathered.size(), free_space ? "free space" : "periodic in x y", st.order,
-                 st.theta, st.leaf, st.levels,
+                 "FMM Coulomb (fix coul/fmm {}): {} charged atoms, {}, {} solver on {} ranks\n"
+                 "  order = {}, theta = {:.3g}, leaf = {}{}\n"
+                 "  estimated relative RMS force error = {:.3g} (requested accuracy {:.3g})\n"
+                 "  largest bytes received by a rank per evaluation = {:.4g}, largest solver "
+                 "memory of a rank = {:.4g} bytes\n",
+                 fix_id, (bigint) d.charges, free_space ? "free space" : "periodic in x y",
+                 distributed ? "distributed" : "replicated", comm->nprocs, d.order, d.theta, d.leaf,
                  free_space ? std::string()
                             : fmt::format(", images = {}, farfield = {}", opts->images,
                                           ffname[(int) opts->farfield]),
-                 st.estimated_error, opts->accuracy);
+                 d.estimated_error, opts->accuracy, d.bytes_received, d.solver_memory);
 }
 
 double CoulFMMEvaluator::sleeper_source_energy()
@@ -389,14 +525,10 @@ double CoulFMMEvaluator::sleeper_source_energy()
   return sleepers ? force->qqrd2e * sleepers->source_energy() : 0.0;
 }
 
-const gcfmm::Stats *CoulFMMEvaluator::stats() const
-{
-  return solver ? &solver->stats() : nullptr;
-}
-
 double CoulFMMEvaluator::memory_usage() const
 {
-  double bytes = (double) (gathered.x.capacity() * 14) * sizeof(double);    // gathered + results
+  // gathered (or local) charges and results
+  double bytes = (double) ((gathered.x.capacity() + local.x.capacity()) * 14) * sizeof(double);
   if (sleepers) bytes += sleepers->memory_usage();
   return bytes;
 }

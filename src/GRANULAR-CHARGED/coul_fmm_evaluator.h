@@ -19,11 +19,14 @@
 #include "coul_fmm_time_stepping.h"
 #include "pointers.h"
 
+#include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
 namespace gcfmm {
+class DistributedSolver;
 class Solver;
 struct Options;
 struct Stats;
@@ -46,7 +49,9 @@ class CoulFMMEvaluator : protected Pointers {
   void check_counted_once(class Fix *self);
   // a solver for these options (the one of the last run if its boundary is the same), the
   // sleepers of `sleep` as a static source if given (errors for what cannot use them)
-  void init(const gcfmm::Options &opts, FixSleepGran *sleep, bool virial);
+  // distribute: gcfmm::DistributedSolver (each rank keeps its charges), else gcfmm::Solver on
+  // the charges of all ranks gathered on every rank
+  void init(const gcfmm::Options &opts, FixSleepGran *sleep, bool virial, bool distribute);
 
   // what the stored evaluation (state rows: CoulFMMTimeStepping::Column) belongs to: record()
   // it before an evaluation, continuity() relates it to the atoms now
@@ -72,7 +77,16 @@ class CoulFMMEvaluator : protected Pointers {
   // and among themselves (computed when first asked after a change of the set)
   double sleeper_pair_energy() const { return pair_energy; }
   double sleeper_source_energy();
-  const gcfmm::Stats *stats() const;
+  // the solver's side of the last evaluation (the same on every rank)
+  struct Diagnostics {
+    double estimated_error = 0.0, theta = 0.0;
+    int order = 0, leaf = 0;
+    double m2l = 0.0, p2p = 0.0;      // interactions of all ranks together
+    double bytes_received = 0.0;      // largest over the ranks, all collectives of the evaluation
+    double solver_memory = 0.0;       // largest over the ranks
+    double charges = 0.0;             // charged atoms evaluated
+  };
+  const Diagnostics &diagnostics_of_last() const { return diagnostics; }
   double memory_usage() const;
 
  private:
@@ -80,9 +94,14 @@ class CoulFMMEvaluator : protected Pointers {
   int groupbit;
   std::unique_ptr<gcfmm::Options> opts;
   std::unique_ptr<gcfmm::Solver> solver;
+  std::unique_ptr<gcfmm::DistributedSolver> distributed_solver;
+  bool distributed;
   int solver_boundary;
   CoulFMMComm mpi;
-  GatheredCharges gathered;
+  GatheredCharges gathered;    // replicated: the charges of all ranks
+  GatheredCharges local;       // distributed: this rank's
+  std::vector<int64_t> ids;
+  Diagnostics diagnostics;
   std::vector<double> result, values, mine;
   double **fresh;    // the fresh evaluation of measure_error()
   int nmax_fresh;
@@ -91,7 +110,16 @@ class CoulFMMEvaluator : protected Pointers {
   double pair_energy;    // C/2 sum_awake q pot^sleepers at the last evaluation
   bool logged;
 
-  std::string solve(bool split);
+  bool evaluate_replicated(const std::function<bool(int)> &charged, double **out, int col,
+                           bool split);
+  bool evaluate_distributed(const std::function<bool(int)> &charged, double **out, int col,
+                            bool split);
+  double add_sleepers_field(const GatheredCharges &targets, size_t first, size_t last, double *pot,
+                            double *ex, double *ey, double *ez);
+  void sum_pair_energy(double qpot);
+  std::string guarded(const std::function<void()> &run,
+                      const std::function<tagint(size_t)> &tag_of);
+  void record_diagnostics();
   void log_parameters();
 };
 

@@ -40,13 +40,13 @@ using MTS = CoulFMMTimeStepping;
 FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), opts(new gcfmm::Options), mpi(new CoulFMMComm(lmp)),
     near(new CoulFMMNearRefresh(lmp, this)), bed_given(false), sleepers_static(true),
-    nevaluations(0), energy_local(0.0), energy_all(0.0), energy_summed(false), ilevel_respa(0),
-    field(nullptr), eval_state(nullptr)
+    distributed(false), nevaluations(0), energy_local(0.0), energy_all(0.0), energy_summed(false),
+    ilevel_respa(0), field(nullptr), eval_state(nullptr)
 {
   scalar_flag = 1;
   extscalar = 1;
   vector_flag = 1;    // diagnostics: solver (error estimate, order, M2L, P2P), MTS check, schedule
-  size_vector = 10;
+  size_vector = 12;
   extvector = 0;
   global_freq = 1;
   energy_global_flag = 1;
@@ -85,7 +85,7 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
   for (int iarg = 3; iarg < narg; iarg += 2) {
     const std::string key = arg[iarg];
     const bool known = reals.count(key) || integers.count(key) || key == "farfield" ||
-        key == "bed" || key == "extrapolate" || key == "sleepers";
+        key == "bed" || key == "extrapolate" || key == "sleepers" || key == "solver";
     if (!known) error->all(FLERR, iarg, "Unknown fix coul/fmm keyword: {}", key);
     if (iarg + (key == "bed" ? 2 : 1) >= narg)
       utils::missing_cmd_args(FLERR, "fix coul/fmm " + key, error);
@@ -107,6 +107,11 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
       if (v != "static" && v != "full")
         error->all(FLERR, iarg + 1, "Fix coul/fmm sleepers must be static or full, got {}", v);
       sleepers_static = v == "static";
+    } else if (key == "solver") {
+      if (v != "distributed" && v != "replicated")
+        error->all(FLERR, iarg + 1, "Fix coul/fmm solver must be distributed or replicated, got {}",
+                   v);
+      distributed = v == "distributed";
     } else if (key == "bed") {
       opts->bed_zlo = utils::numeric(FLERR, v, false, lmp);
       opts->bed_zhi = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
@@ -156,7 +161,7 @@ void FixCoulFMM::init()
   auto sleep = modify->get_fix_by_style("^sleep/gran$");
   evaluator->init(
       *opts, sleep.empty() || !sleepers_static ? nullptr : dynamic_cast<FixSleepGran *>(sleep[0]),
-      thermo_virial);
+      thermo_virial, distributed);
 
   const auto &mts = stepping->settings();
   if (mts.tolerance > 0.0 && comm->me == 0)
@@ -357,22 +362,24 @@ double FixCoulFMM::compute_scalar()
 
 // doc/fix_coul_fmm.md, "Output": 1-4 solver (error estimate, order, M2L, P2P), 5-7 keyword
 // check (last, largest, all checks), 8 interval, 9 the MTS error at the last evaluation that
-// continued a field, 10 evaluations
+// continued a field, 10 evaluations, 11 bytes received by the busiest rank in the last
+// evaluation, 12 the largest solver memory of a rank (bytes)
 double FixCoulFMM::compute_vector(int n)
 {
-  if (n == 4) return stepping->check_last();
-  if (n == 5) return stepping->check_max();
-  if (n == 6) return stepping->check_overall();
-  if (n == 7) return (double) stepping->stride();
-  if (n == 8) return stepping->last_estimate();
-  if (n == 9) return (double) nevaluations;
-  const gcfmm::Stats *st = evaluator->stats();
-  if (!st) return 0.0;
-  if (n == 0) return st->estimated_error;
-  if (n == 1) return st->order;
-  if (n == 2) return (double) st->m2l_count;
-  if (n == 3) return (double) st->p2p_pairs;
-  return 0.0;
+  const auto &d = evaluator->diagnostics_of_last();
+  const double values[12] = {d.estimated_error,
+                             (double) d.order,
+                             d.m2l,
+                             d.p2p,
+                             stepping->check_last(),
+                             stepping->check_max(),
+                             stepping->check_overall(),
+                             (double) stepping->stride(),
+                             stepping->last_estimate(),
+                             (double) nevaluations,
+                             d.bytes_received,
+                             d.solver_memory};
+  return n >= 0 && n < 12 ? values[n] : 0.0;
 }
 
 double FixCoulFMM::memory_usage()

@@ -75,6 +75,7 @@ class FixCoulFMM : public Fix {
   bool bed_given;                  // bed zlo/zhi given by the user (farfield average)
   std::string periodic_keyword;    // last of images/farfield given (ignored in free space)
   bool sleepers_static;            // keyword sleepers: static (true) or full
+  bool distributed;                // keyword solver: distributed (true) or replicated
 
   bigint nevaluations;             // evaluations so far (diagnostic)
 

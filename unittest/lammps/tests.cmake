@@ -5,6 +5,8 @@ gc_lammps_test(test_jkr_marshall_reproducible NP 1 2 SOURCES test_jkr_marshall_r
 target_compile_definitions(test_jkr_marshall_reproducible PRIVATE GC_LMP_EXECUTABLE="$<TARGET_FILE:lmp>")
 add_dependencies(test_jkr_marshall_reproducible lmp)
 gc_lammps_test(test_coul_fmm NP 1 2 SOURCES test_coul_fmm.cpp)
+# keyword solver distributed on 1, 2 and 3 ranks (3 oversubscribed on 2 cores)
+gc_lammps_test(test_coul_fmm_distributed NP 1 2 3 SOURCES test_coul_fmm_distributed.cpp)
 # fix coul/fmm's time stepping alone (no LAMMPS instance)
 gc_lammps_test(test_coul_fmm_time_stepping SOURCES test_coul_fmm_time_stepping.cpp)
 gc_lammps_test(test_packing_computes NP 1 2 SOURCES test_packing_computes.cpp)

@@ -33,6 +33,7 @@ void Solver::energy_potential(double *u) const {
 const Stats &Solver::stats() const { return impl_->stats; }
 const Options &Solver::options() const { return impl_->opts; }
 std::size_t Solver::size() const { return impl_->n; }
+std::size_t Solver::memory_bytes() const { return impl_->memory_bytes(); }
 
 void Solver::partition(int part, int nparts, std::size_t &first, std::size_t &last) const {
   if (!impl_->built) throw std::runtime_error("gcfmm: partition() called before build()");

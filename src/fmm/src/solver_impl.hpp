@@ -236,6 +236,15 @@ struct SolverCore {
 
   bool periodic() const { return opts.boundary == Boundary::Periodic2D; }
   std::size_t expansion_size() const { return ops->size(); }
+  //! bytes held: tree, lists, expansions, per-particle arrays, scratch, far-field operator
+  std::size_t memory_bytes() const {
+    std::size_t b = tree_bytes(tree) + lists_bytes(lists) + far.memory_bytes();
+    for (const auto *v : {&scaled_x, &scaled_y, &scaled_z, &multipole, &local, &sorted_q, &sorted_pot, &sorted_ex,
+                          &sorted_ey, &sorted_ez, &sorted_average_pot, &leaf_prefix})
+      b += vector_bytes(*v);
+    b += vector_bytes(has_local) + vector_bytes(batch_m) + vector_bytes(batch_r) + vector_bytes(coincident);
+    return b + (ops ? ops->size() * sizeof(double) * 3 * Operators::kBatch : 0);
+  }
   double *multipole_of(std::size_t node) { return multipole.data() + node * expansion_size(); }
   double *local_of(std::size_t node) { return local.data() + node * expansion_size(); }
 

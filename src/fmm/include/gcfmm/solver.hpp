@@ -118,6 +118,8 @@ class Solver {
   const Options &options() const;
   /** @brief Number of particles of the last build(). */
   std::size_t size() const;
+  /** @brief Bytes held (tree, lists, expansions, per-particle arrays, scratch, far-field operator). */
+  std::size_t memory_bytes() const;
   /** @brief Range [first, last) of particle indices in the internal (sorted) order computed by
    *  work partition `part` of `nparts` (for tests and diagnostics). */
   void partition(int part, int nparts, std::size_t &first, std::size_t &last) const;
