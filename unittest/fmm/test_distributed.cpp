@@ -6,10 +6,10 @@
 // of the near field for the resolved (p, theta), measured 1.2-4x above it (README, "Error
 // control"). At P ranks every interaction is still one of the same kinds, P2P, or M2L under
 // the same MAC (r_A + r_B < theta d) and the same order, or M2P from a LET node sent as
-// multipole only, whose point MAC 2 r_B < theta d (doc/fmm-distributed.md, eq. (D.1)) is
-// stricter than the M2L one (its truncation error ~ (theta/2)^(p+1) per term against
-// theta^(p+1)), so the same bound is asked: error <= accuracy against the direct sum, no
-// slack, for every P and partition. With FarField::Exact the reference adds the far-field
+// multipole only, under the point MAC r_B < theta d (doc/fmm-distributed.md, eq. (D.1)): the
+// same ratio as the M2L MAC with no local-expansion truncation, so an M2P term errs no more
+// than an M2L term at the MAC's limit. Hence the same bound is asked: error <= accuracy
+// against the direct sum, no slack, for every P and partition. With FarField::Exact the reference adds the far-field
 // operator's own result (the same linear operator at every P: Solver(Exact) - Solver(None) at
 // 1 rank), so the comparison tests the distributed near field and the summed node potentials;
 // the operator's accuracy is test_lattice_sum's business.
@@ -206,10 +206,13 @@ void check_all_partitions(const Options &o, const Particles &p, double l, const 
   const Field ref = reference(o, p, l);
   const RankRun one = distributed(o, p, std::vector<int>(p.size(), 0), 1, l);
   EXPECT_LE(gcfmm_test::force_error(p.q, one.f, ref), acc) << what << " P = 1";
+  double worst = 0.0, worst1 = 0.0;
   for (int P : ranks)
     for (Split split : {Split::GridXY, Split::GridXYZ, Split::Random}) {
       const RankRun r = distributed(o, p, partition(p, P, split), P, l);
       const double e = gcfmm_test::force_error(p.q, r.f, ref), e1 = gcfmm_test::force_error(p.q, r.f, one.f);
+      worst = std::max(worst, e);
+      worst1 = std::max(worst1, e1);
       EXPECT_LE(e, acc) << what << " P = " << P << " " << name(split);
       EXPECT_LE(e1, acc) << what << " P = " << P << " " << name(split) << " against P = 1";
       EXPECT_LE(gcfmm_test::potential_error(r.f, ref), acc) << what << " P = " << P << " " << name(split);
@@ -218,6 +221,8 @@ void check_all_partitions(const Options &o, const Particles &p, double l, const 
       for (const auto &st : r.stats) let += st.let_nodes_received;
       EXPECT_GT(let, 0u) << "LETs were exchanged";
     }
+  std::printf("%s: P = 1 error %.3g; largest over P, partitions: %.3g (against P = 1: %.3g)\n", what,
+              gcfmm_test::force_error(p.q, one.f, ref), worst, worst1);
 }
 
 }  // namespace
@@ -324,7 +329,9 @@ TEST(Distributed, MultipoleOnlyNodesAreNeverDirect) {
 // periodic with every far field.
 TEST(Distributed, OneRankIsSolverBitIdentical) {
   const auto cube = gcfmm_test::random_cube(2000, 31);
-  const auto dep = gcfmm_test::deposition(2000, 32);
+  auto dep = gcfmm_test::deposition(2000, 32);
+  std::mt19937_64 g(33);
+  for (auto &q : dep.q) q = 0.5 + std::uniform_real_distribution<double>(0.0, 1.0)(g);  // sums depend on order
   struct Case {
     Options o;
     const Particles *p;
@@ -500,19 +507,21 @@ TEST(Distributed, CoincidentParticlesOnTwoRanks) {
 // The LET is a surface: at P = 8 with a spatial partition each rank receives much less than
 // all particles (N x 32 bytes would be the gather of x, y, z, q that the LAMMPS fix does today).
 TEST(Distributed, LetIsMuchSmallerThanAllParticles) {
-  const std::size_t n = 40000;
+  const std::size_t n = 200000;
   const double l = gcfmm_test::deposition_width(n);
   const auto p = gcfmm_test::deposition(n, 81);
   const Options o = opts_of(1e-4, Boundary::Periodic2D, FarField::Exact);
   const RankRun r = distributed(o, p, partition(p, 8, Split::GridXY), 8, l);
   std::size_t most = 0, particles = 0;
   for (const auto &st : r.stats) {
-    std::printf("rank: received %zu bytes, %zu nodes, %zu particles; sent %zu; m2p %zu\n", st.bytes_received,
-                st.let_nodes_received, st.let_particles_received, st.bytes_sent, st.m2p_count);
     most = std::max(most, st.bytes_received);
     particles = std::max(particles, st.let_particles_received);
     EXPECT_GT(st.bytes_received, 0u);
   }
-  EXPECT_LT(double(most), 0.5 * n * 32.0) << "largest LET received " << most << " bytes";
-  EXPECT_LT(double(particles), 0.5 * n);
+  // about a fifth of N x 32 bytes and a tenth of the particles here; the share falls as the
+  // ranks' domains grow against the opening distance (doc/fmm-distributed.md, bench table)
+  EXPECT_LT(double(most), 0.3 * n * 32.0) << "largest LET received " << most << " bytes";
+  EXPECT_LT(double(particles), 0.15 * n);
+  std::printf("P = 8, N = %zu: largest LET received %zu bytes = %.3g N x 32 bytes, %zu particles\n", n, most,
+              most / (32.0 * n), particles);
 }

@@ -42,7 +42,7 @@ class ThreadGroup {
       std::abort();
     }
   }
-  static constexpr int kHangSeconds = 120;
+  static constexpr int kHangSeconds = 30;
   std::vector<std::vector<double>> doubles_;                      // one slot per rank
   std::vector<const std::vector<std::vector<unsigned char>> *> bytes_;  // each rank's send buffers
 

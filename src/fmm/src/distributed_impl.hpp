@@ -40,23 +40,24 @@ struct ReceivedLet {
   std::vector<double> q;             //!< particle charges (all nonzero)
   std::vector<std::int64_t> ids;     //!< particle ids
   std::vector<double> multipole;     //!< ops.size() doubles per node (node 0: zero)
-  std::vector<char> multipole_only;  //!< truncated nodes (no particles, never P2P)
+  std::vector<char> multipole_only;  //!< particle range incomplete (truncated or above one): never P2P
+  std::vector<char> truncated;       //!< multipole received (no children, no particles)
   std::size_t nodes_received = 0, particles_received = 0;
   void clear();
   std::size_t memory_bytes() const;
 };
 
-/** The LET of `tree` (multipoles `multipole`, charges q in tree order, ids in tree order) for a
- *  rank whose targets lie in `box`, for every image shift, appended to `out` (format in
- *  doc/fmm-distributed.md, "Buffer layout"). Nothing is written for an empty box or a tree
- *  without charge. */
-void pack_let(const Tree &tree, const std::vector<char> &charged, const double *multipole, const double *q,
+/** The LET of `tree` (multipoles `multipole`, charges q in tree order, ids in tree order,
+ *  `charged` the number of nonzero charges per node) for a rank whose targets lie in `box`,
+ *  for every image shift, written to `out` (format in doc/fmm-distributed.md, "Buffer
+ *  layout"). Nothing is written for an empty box or a tree without charge. */
+void pack_let(const Tree &tree, const std::vector<std::uint32_t> &charged, const double *multipole, const double *q,
               const std::int64_t *ids, const Operators &ops, const Box &box, const std::vector<Vec3> &shifts,
               double theta, std::vector<unsigned char> &out);
 
-/** All ranks' LET buffers merged into one source tree (ReceivedLet). */
-void unpack_lets(const std::vector<std::vector<unsigned char>> &recv, int self, const Operators &ops,
-                 ReceivedLet &let);
+/** All ranks' LET buffers merged into one source tree (ReceivedLet), with the multipoles of
+ *  the nodes that were not truncated computed here (P2M of the received particles, M2M). */
+void unpack_lets(const std::vector<std::vector<unsigned char>> &recv, int self, Operators &ops, ReceivedLet &let);
 
 }  // namespace detail
 
@@ -68,7 +69,7 @@ struct DistributedSolver::Impl {
   bool box_set = false;
   bool evaluated = false;           // the last evaluate() completed
   std::vector<std::int64_t> sorted_ids;  // ids in tree order
-  std::vector<char> charged;        // node of this rank's tree holds a nonzero charge
+  std::vector<std::uint32_t> charged;  // nonzero charges per node of this rank's tree
   std::vector<double> boxes;        // every rank's target box, 6 doubles per rank (lo, hi)
   std::vector<std::vector<unsigned char>> send, recv;  // LET buffers
   detail::ReceivedLet let;

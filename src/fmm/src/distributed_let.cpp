@@ -14,11 +14,15 @@ namespace {
 
 // per node on the wire: centre, radius, then child, nchild, begin, end, flags
 constexpr std::size_t kNodeBytes = 4 * sizeof(double) + 5 * sizeof(std::int32_t);
-// flags bit: the node's particle range is incomplete (it is truncated, no children and no
-// particles, or has a truncated descendant): never P2P (build_lists' multipole_only)
-constexpr std::int32_t kMultipoleOnly = 1;
+// flags bits: the node's particle range is incomplete (it is truncated or has a truncated
+// descendant): never P2P (build_lists' multipole_only); the node is truncated (no children, no
+// particles): its multipole is sent (the receiver computes all others from what it receives)
+constexpr std::int32_t kMultipoleOnly = 1, kTruncated = 2;
 
-// the m >= 0 coefficients of an expansion (symmetrize() restores m < 0): (p+1)(p+2)/2 complex
+// per particle on the wire: x, y, z, q, id
+constexpr std::size_t kParticleBytes = 4 * sizeof(double) + sizeof(std::int64_t);
+
+// the m >= 0 coefficients of an expansion (upward_pass' symmetrize() restores m < 0): (p+1)(p+2)/2 complex
 inline std::size_t half_size(int p) { return static_cast<std::size_t>(p + 1) * (p + 2); }
 
 template <class T>
@@ -50,11 +54,13 @@ struct LetNode {
 };
 
 // The traversal of the sender's tree for one receiving box (doc/fmm-distributed.md, eq. (D.1)):
-// node n is sent multipole only when 2 r_n < theta dist(c_n + s, B) for every shift s, and no
-// particle of it can be within the coincidence radius of the box.
+// node n is sent multipole only when r_n < theta dist(c_n + s, B) for every shift s (the point
+// MAC at every target the receiver can have), no particle of it can be within the coincidence
+// radius of the box, and its charges would take more bytes than its multipole.
 struct LetBuilder {
   const Tree &tree;
-  const std::vector<char> &charged;
+  const std::vector<std::uint32_t> &charged;
+  std::size_t multipole_bytes;  // of one truncated node on the wire
   const double *q;
   const Box &box;
   const std::vector<Vec3> &shifts;
@@ -65,7 +71,7 @@ struct LetBuilder {
   bool multipole_only(const Node &A) const {
     for (const Vec3 &s : shifts) {
       const double d = box.distance(A.center + s);
-      if (!(2.0 * A.radius < theta * d && d - A.radius > 2.0 * kCoincidenceRadius)) return false;
+      if (!(A.radius < theta * d && d - A.radius > 2.0 * kCoincidenceRadius)) return false;
     }
     return true;
   }
@@ -79,9 +85,12 @@ struct LetBuilder {
     out.radius = A.radius;
     out.source = src;
     out.begin = static_cast<std::int32_t>(particles.size());
-    if (multipole_only(A)) {
-      out.flags = kMultipoleOnly;
-    } else if (A.leaf()) {
+    // a node of few charges is cheaper sent as their particles (a leaf of the LET) than as a
+    // multipole; a leaf's particles are always sent when it is not truncated
+    const bool few = charged[src] * kParticleBytes <= multipole_bytes;
+    if (!few && multipole_only(A)) {
+      out.flags = kMultipoleOnly | kTruncated;
+    } else if (A.leaf() || few) {
       for (std::uint32_t k = A.begin; k < A.end; ++k)
         if (q[k] != 0.0) particles.push_back(k);  // zero charges are sources of nothing
     } else {
@@ -103,19 +112,21 @@ struct LetBuilder {
 
 }  // namespace
 
-void pack_let(const Tree &tree, const std::vector<char> &charged, const double *multipole, const double *q,
+void pack_let(const Tree &tree, const std::vector<std::uint32_t> &charged, const double *multipole, const double *q,
               const std::int64_t *ids, const Operators &ops, const Box &box, const std::vector<Vec3> &shifts,
               double theta, std::vector<unsigned char> &out) {
   out.clear();
   if (box.empty() || tree.nodes.empty() || !charged[0]) return;
-  LetBuilder b{tree, charged, q, box, shifts, theta, {}, {}};
+  LetBuilder b{tree, charged, half_size(ops.order()) * sizeof(double), q, box, shifts, theta, {}, {}};
   b.nodes.resize(1);
   b.emit(0, 0);
   const int p = ops.order();
   const std::size_t S = ops.size() / 2, half = half_size(p);
   const std::size_t nn = b.nodes.size(), np = b.particles.size();
-  out.reserve(2 * sizeof(std::int64_t) + nn * (kNodeBytes + half * sizeof(double)) +
-              np * (4 * sizeof(double) + sizeof(std::int64_t)));
+  std::size_t truncated = 0;
+  for (const LetNode &n : b.nodes) truncated += (n.flags & kTruncated) ? 1 : 0;
+  out.reserve(2 * sizeof(std::int64_t) + nn * kNodeBytes + truncated * half * sizeof(double) +
+              np * kParticleBytes);
   put(out, static_cast<std::int64_t>(nn));
   put(out, static_cast<std::int64_t>(np));
   for (const LetNode &n : b.nodes) {
@@ -123,6 +134,7 @@ void pack_let(const Tree &tree, const std::vector<char> &charged, const double *
     for (std::int32_t v : {n.child, n.nchild, n.begin, n.end, n.flags}) put(out, v);
   }
   for (const LetNode &n : b.nodes) {
+    if (!(n.flags & kTruncated)) continue;
     const double *M = multipole + static_cast<std::size_t>(n.source) * ops.size();
     for (std::size_t part = 0; part < 2; ++part)  // real parts, then imaginary parts
       for (int k = 0; k <= p; ++k)
@@ -143,16 +155,16 @@ void ReceivedLet::clear() {
   ids.clear();
   multipole.clear();
   multipole_only.clear();
+  truncated.clear();
   nodes_received = particles_received = 0;
 }
 
 std::size_t ReceivedLet::memory_bytes() const {
   return tree_bytes(tree) + vector_bytes(q) + vector_bytes(ids) + vector_bytes(multipole) +
-         vector_bytes(multipole_only);
+         vector_bytes(multipole_only) + vector_bytes(truncated);
 }
 
-void unpack_lets(const std::vector<std::vector<unsigned char>> &recv, int self, const Operators &ops,
-                 ReceivedLet &let) {
+void unpack_lets(const std::vector<std::vector<unsigned char>> &recv, int self, Operators &ops, ReceivedLet &let) {
   let.clear();
   // sizes first: the virtual root, the ranks' roots contiguous after it, then their other nodes
   std::size_t roots = 0, total_nodes = 1, total_particles = 0;
@@ -174,6 +186,7 @@ void unpack_lets(const std::vector<std::vector<unsigned char>> &recv, int self, 
   nodes.assign(total_nodes, Node{});
   let.multipole.assign(total_nodes * size, 0.0);
   let.multipole_only.assign(total_nodes, 0);
+  let.truncated.assign(total_nodes, 0);
   let.tree.xs.resize(total_particles);
   let.tree.ys.resize(total_particles);
   let.tree.zs.resize(total_particles);
@@ -206,15 +219,20 @@ void unpack_lets(const std::vector<std::vector<unsigned char>> &recv, int self, 
       A.nchild = nchild;
       A.begin = static_cast<std::uint32_t>(pbase + begin);
       A.end = static_cast<std::uint32_t>(pbase + end);
-      A.parent = j == 0 ? 0 : -1;  // (unused by the traversal)
+      A.parent = -1;  // the roots' (no M2M into the virtual root); the children's below
       let.multipole_only[place(j)] = (flags & kMultipoleOnly) ? 1 : 0;
+      let.truncated[place(j)] = (flags & kTruncated) ? 1 : 0;
     }
     for (std::size_t j = 0; j < nn; ++j) {
+      const Node &A = nodes[place(j)];
+      for (int c = 0; c < A.nchild; ++c) nodes[A.child + c].parent = static_cast<std::int32_t>(place(j));
+    }
+    for (std::size_t j = 0; j < nn; ++j) {
+      if (!let.truncated[place(j)]) continue;
       double *M = let.multipole.data() + place(j) * size;
       for (std::size_t part = 0; part < 2; ++part)
         for (int k = 0; k <= p; ++k)
           for (int m = 0; m <= k; ++m) M[part * S + k * k + k + m] = rd.get<double>();
-      ops.symmetrize(M);
     }
     for (auto *v : {&let.tree.xs, &let.tree.ys, &let.tree.zs, &let.q})
       for (std::size_t k = 0; k < np; ++k) (*v)[pbase + k] = rd.get<double>();
@@ -223,6 +241,8 @@ void unpack_lets(const std::vector<std::vector<unsigned char>> &recv, int self, 
     base += nn - 1;
     pbase += np;
   }
+  // the other multipoles from the received particles and multipoles (eqs. (3.9), (3.10))
+  upward_pass(let.tree, let.q.data(), ops, let.multipole, &let.truncated);
 }
 
 }  // namespace detail

@@ -95,15 +95,16 @@ void DistributedSolver::Impl::record_coincidence(std::int64_t a, std::int64_t b)
   coincident_second = std::max(a, b);
 }
 
-// charged[i]: node i of this rank's tree holds a nonzero charge (only those are sent)
+// charged[i]: the number of nonzero charges in node i of this rank's tree (only nodes with
+// charge are sent)
 void DistributedSolver::Impl::mark_charged_nodes() {
   const auto &nodes = core.tree.nodes;
   charged.assign(nodes.size(), 0);
   for (std::size_t i = nodes.size(); i-- > 0;) {
     const Node &A = nodes[i];
     if (A.leaf())
-      for (std::uint32_t k = A.begin; k < A.end && !charged[i]; ++k) charged[i] = core.sorted_q[k] != 0.0;
-    if (charged[i] && A.parent >= 0) charged[A.parent] = 1;
+      for (std::uint32_t k = A.begin; k < A.end; ++k) charged[i] += core.sorted_q[k] != 0.0 ? 1 : 0;
+    if (A.parent >= 0) charged[A.parent] += charged[i];
   }
 }
 

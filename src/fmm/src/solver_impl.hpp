@@ -73,16 +73,19 @@ inline double length_unit(double extent) {
 // Upward pass (doc/theory.md, eqs. (3.9), (3.10)): P2M at the leaves, M2M to the parents, for
 // all nodes of `tree` with the charges q in tree order; `multipole` holds ops.size() doubles
 // per node (overwritten). Children have larger indices than their parents, so one reverse
-// sweep suffices. Shared by Solver and StaticSourceField.
-inline void upward_pass(const Tree &tree, const double *q, Operators &ops, std::vector<double> &multipole) {
+// sweep suffices. Shared by Solver, StaticSourceField and the received LETs of
+// DistributedSolver; for the last, `given` flags the leaves whose multipole is already in
+// `multipole` (received, not computed: no P2M, not zeroed; the caller zeroes all other nodes).
+inline void upward_pass(const Tree &tree, const double *q, Operators &ops, std::vector<double> &multipole,
+                        const std::vector<char> *given = nullptr) {
   const auto &nodes = tree.nodes;
   const auto &xs = tree.xs, &ys = tree.ys, &zs = tree.zs;
   const std::size_t size = ops.size();
-  multipole.assign(nodes.size() * size, 0.0);
+  if (!given) multipole.assign(nodes.size() * size, 0.0);
   for (std::size_t i = nodes.size(); i-- > 0;) {
     const Node &A = nodes[i];
     double *Mi = multipole.data() + i * size;
-    if (A.leaf())
+    if (A.leaf() && !(given && (*given)[i]))
       ops.p2m_batch(A.count(), xs.data() + A.begin, ys.data() + A.begin, zs.data() + A.begin, q + A.begin, A.center,
                     Mi);
     ops.symmetrize(Mi);
