@@ -97,6 +97,20 @@ inline std::string error_of(const std::vector<std::string> &cmds)
   return "no error";
 }
 
+// the size of MPI_COMM_WORLD and this process's rank in it
+inline int nprocs()
+{
+  int n;
+  MPI_Comm_size(MPI_COMM_WORLD, &n);
+  return n;
+}
+inline int rank()
+{
+  int me;
+  MPI_Comm_rank(MPI_COMM_WORLD, &me);
+  return me;
+}
+
 // per-atom property `name` (cols values each) of all atoms, ordered by atom ID
 inline std::vector<double> gather(Lmp &l, const char *name, int cols)
 {

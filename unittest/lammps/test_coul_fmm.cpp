@@ -18,6 +18,7 @@ using gctest::Lmp;
 using gctest::rel_rms;
 using gctest::gather;
 using gctest::error_of;
+using gctest::nprocs;
 
 namespace {
 
@@ -32,12 +33,6 @@ void random_charges(Lmp &l, const std::string &boundary, int n, double lx, doubl
           "neighbor 1.0 bin", "thermo_style custom step pe", "thermo_modify norm no"});
 }
 
-int nprocs()
-{
-  int n;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
 }    // namespace
 
 // free space vs the exact direct sum (coul/cut beyond the box diagonal), 4000 charges: enough

@@ -19,25 +19,15 @@
 #include <vector>
 
 using gctest::error_of;
+using gctest::nprocs;
+using gctest::rank;
 using gctest::gather;
 using gctest::Lmp;
 using gctest::rel_rms;
 
 namespace {
 
-int nprocs()
-{
-  int n;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
 
-int rank()
-{
-  int me;
-  MPI_Comm_rank(MPI_COMM_WORLD, &me);
-  return me;
-}
 
 // the deposition geometry: a dense bed of charges near the floor and a few sparse charges high
 // above it, net charged like a deposited bed. Atom IDs of create_atoms depend on the processor

@@ -30,17 +30,12 @@
 #include <vector>
 
 using gctest::Lmp;
+using gctest::nprocs;
 
 namespace {
 constexpr int NATOMS = 27;
 constexpr double TOL = 1e-12;
 
-int nprocs()
-{
-  int n;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
 
 const char *MARSHALL_11 = "jkr/marshall 2e8 0.7 0.33 0.01 damping marshall tangential marshall "
                           "0.3 rolling marshall 0.01 twisting marshall/jkr";

@@ -17,6 +17,7 @@
 #include <vector>
 
 using gctest::Lmp;
+using gctest::nprocs;
 
 namespace {
 constexpr int NATOMS = 27;
@@ -57,12 +58,6 @@ void expect_same(const std::vector<double> &a, const std::vector<double> &b, dou
     EXPECT_NEAR(a[k], b[k], rel * scale[k % 5]) << "component " << k;
 }
 
-int nprocs()
-{
-  int n;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
 }    // namespace
 
 // 1e-9 of each quantity's scale is far above double round-off after 4000 steps and far below

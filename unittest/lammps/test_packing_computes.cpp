@@ -19,16 +19,10 @@
 
 using gctest::JKR;
 using gctest::Lmp;
+using gctest::nprocs;
 using gctest::error_of;
 
 namespace {
-
-int nprocs()
-{
-  int n;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
 
 // ---- compute outputs through the library interface (collective: invokes the compute) --------
 void *extract(Lmp &l, const std::string &id, int style, int type)

@@ -39,6 +39,7 @@
 #include <vector>
 
 using gctest::Lmp;
+using gctest::nprocs;
 using gctest::rel_rms;
 using gctest::gather;
 using gctest::error_of;
@@ -46,13 +47,6 @@ using gctest::error_of;
 namespace {
 const char *MODEL = "jkr/marshall 2e8 0.7 0.33 0.01 damping marshall tangential marshall 0.3 "
                     "rolling marshall 0.01 twisting marshall/jkr";
-
-int nprocs()
-{
-  int n;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
 
 // 27 spheres on a slightly compressed 3 x 3 x 3 lattice on a JKR floor: every sphere touches
 // its lattice neighbours
