@@ -42,19 +42,13 @@ class Deferred {
 }  // namespace
 
 DistributedSolver::DistributedSolver(const Options &opts, Communicator &comm) : impl_(new Impl(comm)) {
-  opts.validate();
   SolverCore &c = impl_->core;
-  c.opts = opts;
-  c.res = resolve(opts);
-  c.opts.order = c.res.order;
-  c.opts.theta = c.res.theta;
-  c.opts.leaf = c.res.leaf;
-  c.ops.reset(new Operators(c.res.order));
+  c.configure(opts);
   DistributedStats &s = impl_->stats;
-  s.order = c.res.order;
-  s.theta = c.res.theta;
-  s.leaf = c.res.leaf;
-  s.estimated_error = c.res.estimated_error;
+  s.order = c.stats.order;
+  s.theta = c.stats.theta;
+  s.leaf = c.stats.leaf;
+  s.estimated_error = c.stats.estimated_error;
 }
 
 DistributedSolver::~DistributedSolver() = default;

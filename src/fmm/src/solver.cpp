@@ -6,20 +6,7 @@ namespace gcfmm {
 
 using namespace detail;
 
-Solver::Solver(const Options &opts) : impl_(new Impl) {
-  opts.validate();
-  impl_->opts = opts;
-  impl_->res = resolve(opts);
-  impl_->opts.order = impl_->res.order;
-  impl_->opts.theta = impl_->res.theta;
-  impl_->opts.leaf = impl_->res.leaf;
-  impl_->ops.reset(new Operators(impl_->res.order));
-  Stats &s = impl_->stats;
-  s.order = impl_->res.order;
-  s.theta = impl_->res.theta;
-  s.leaf = impl_->res.leaf;
-  s.estimated_error = impl_->res.estimated_error;
-}
+Solver::Solver(const Options &opts) : impl_(new Impl) { impl_->configure(opts); }
 
 Solver::~Solver() = default;
 

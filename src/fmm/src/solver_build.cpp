@@ -8,6 +8,20 @@ namespace gcfmm {
 
 using namespace detail;
 
+void SolverCore::configure(const Options &o) {
+  o.validate();
+  opts = o;
+  res = resolve(o);
+  opts.order = res.order;
+  opts.theta = res.theta;
+  opts.leaf = res.leaf;
+  ops.reset(new Operators(res.order));
+  stats.order = res.order;
+  stats.theta = res.theta;
+  stats.leaf = res.leaf;
+  stats.estimated_error = res.estimated_error;
+}
+
 // Positions of a periodic system are wrapped into the primary cell first; all positions are
 // then expressed in the length unit h (the cell's for Periodic2D, the particles' extent in
 // free space), so the tree, the lists and the expansions see coordinates of order 1.

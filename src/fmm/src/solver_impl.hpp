@@ -258,6 +258,8 @@ struct SolverCore {
     return r;
   }
 
+  // validated options, resolved order/theta/leaf, operators and the stats they fix
+  void configure(const Options &o);
   // ---- build phases ----
   void build_tree(const double *x, const double *y, const double *z);
   // the two halves of build_tree(): h from the particles' extent (free) or the cell, then the
