@@ -122,7 +122,8 @@ int main(int argc, char **argv) {
         for (const Layout &lay : layouts) {
           const auto n = static_cast<std::size_t>(weak ? nd * lay.P / 8.0 : nd);
           const double l = gcfmm_test::deposition_width(n);
-          const Particles p = periodic ? gcfmm_test::deposition(n, 1) : gcfmm_test::random_cube(n, 1, std::cbrt(double(n)));
+          const Particles p =
+              periodic ? gcfmm_test::deposition(n, 1) : gcfmm_test::random_cube(n, 1, std::cbrt(double(n)));
           const Row row = run(o, p, gcfmm_test::grid_partition(p, lay.px, lay.py, lay.pz), lay.P, l);
           if (lay.P == 1) memory_one = double(row.memory);
           char t[32] = "";

@@ -361,7 +361,8 @@ TEST(Distributed, PeriodicNoFarField) {
 // (every rank of every run sets up its far-field operator: fewer P under the sanitizer build)
 TEST(Distributed, PeriodicExactFarField) {
   const double l = gcfmm_test::deposition_width(2500);
-  const std::vector<int> ranks = std::getenv("GCFMM_TEST_SMALL") ? std::vector<int>{3, 8} : std::vector<int>{2, 3, 4, 8};
+  const std::vector<int> ranks =
+      std::getenv("GCFMM_TEST_SMALL") ? std::vector<int>{3, 8} : std::vector<int>{2, 3, 4, 8};
   check_all_partitions(opts_of(1e-4, Boundary::Periodic2D, FarField::Exact), gcfmm_test::deposition(2500, 52), l,
                        ranks, "periodic exact");
 }
