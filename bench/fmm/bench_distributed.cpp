@@ -4,8 +4,8 @@
 //
 // Geometries: "deposition" (Periodic2D, images 1, FarField::Exact with the column [0, 160] given
 // by set_z_range; lx = ly = 28 sqrt(N / 2000), 90% of equal charges in a dense bed of volume
-// fraction 0.3 about 32 high, 10% up to z = 160, as unittest/fmm/fmm_test_util.hpp) and "cube"
-// (free space, N random charges of both signs in a cube of side N^(1/3), i.e. unit density).
+// fraction 0.3 about 32 high, 10% up to z = 160: gcfmm_test::deposition) and "cube" (free space,
+// N random charges of both signs in a cube of side N^(1/3), i.e. unit density).
 // Partitions: an x-y grid of P ranks (1x1, 2x1, 2x2, 4x2, as LAMMPS `processors * * 1`), and at
 // P = 8 also a 2x2x2 grid (a z split). Strong scaling: N fixed; weak: N P / 8 particles, so
 // that N / P = N / 8 at every P (and the P = 8 row is the strong one's).
@@ -25,65 +25,18 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <random>
 #include <string>
 #include <vector>
 
 #include "gcfmm/distributed_solver.hpp"
+#include "fmm_test_util.hpp"
 #include "thread_communicator.hpp"
 
 using namespace gcfmm;
 
 namespace {
 
-struct Particles {
-  std::vector<double> x, y, z, q;
-  std::size_t size() const { return x.size(); }
-};
-
-Particles deposition(std::size_t n, unsigned seed, double &l) {
-  l = 28.0 * std::sqrt(double(n) / 2000.0);
-  std::mt19937_64 g(seed);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  const std::size_t nbed = n * 9 / 10;
-  const double hbed = nbed * (4.0 / 3.0 * M_PI) / (0.3 * l * l);
-  Particles p;
-  for (std::size_t i = 0; i < n; ++i) {
-    p.x.push_back(l * u(g));
-    p.y.push_back(l * u(g));
-    p.z.push_back(i < nbed ? 1.0 + hbed * u(g) : 1.0 + hbed + (159.0 - hbed) * u(g));
-    p.q.push_back(1.0);
-  }
-  return p;
-}
-
-Particles cube(std::size_t n, unsigned seed) {
-  const double side = std::cbrt(double(n));
-  std::mt19937_64 g(seed);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  Particles p;
-  for (std::size_t i = 0; i < n; ++i) {
-    p.x.push_back(side * u(g));
-    p.y.push_back(side * u(g));
-    p.z.push_back(side * u(g));
-    p.q.push_back((u(g) < 0.5 ? -1.0 : 1.0) * (0.5 + u(g)));
-  }
-  return p;
-}
-
-// px x py x pz grid over the particles' bounding box
-std::vector<int> grid(const Particles &p, int px, int py, int pz) {
-  const auto [xlo, xhi] = std::minmax_element(p.x.begin(), p.x.end());
-  const auto [ylo, yhi] = std::minmax_element(p.y.begin(), p.y.end());
-  const auto [zlo, zhi] = std::minmax_element(p.z.begin(), p.z.end());
-  auto cell = [](double v, double lo, double hi, int k) {
-    return std::min(k - 1, static_cast<int>(k * (v - lo) / (hi - lo + 1e-300)));
-  };
-  std::vector<int> r(p.size());
-  for (std::size_t i = 0; i < p.size(); ++i)
-    r[i] = (cell(p.x[i], *xlo, *xhi, px) * py + cell(p.y[i], *ylo, *yhi, py)) * pz + cell(p.z[i], *zlo, *zhi, pz);
-  return r;
-}
+using gcfmm_test::Particles;
 
 struct Row {
   std::size_t bytes = 0, memory = 0, let_nodes = 0, let_particles = 0;
@@ -98,14 +51,7 @@ Row run(const Options &o, const Particles &p, const std::vector<int> &rank, int 
     const int r = comm.rank();
     Particles mine;
     std::vector<std::int64_t> ids;
-    for (std::size_t i = 0; i < p.size(); ++i)
-      if (rank[i] == r) {
-        mine.x.push_back(p.x[i]);
-        mine.y.push_back(p.y[i]);
-        mine.z.push_back(p.z[i]);
-        mine.q.push_back(p.q[i]);
-        ids.push_back(static_cast<std::int64_t>(i));
-      }
+    gcfmm_test::rank_share(p, rank, r, mine, ids);
     DistributedSolver s(o, comm);
     if (o.boundary == Boundary::Periodic2D) {
       s.set_box(0.0, 0.0, l, l);
@@ -175,9 +121,10 @@ int main(int argc, char **argv) {
         }
         for (const Layout &lay : layouts) {
           const auto n = static_cast<std::size_t>(weak ? nd * lay.P / 8.0 : nd);
-          double l = 0.0;
-          const Particles p = periodic ? deposition(n, 1, l) : cube(n, 1);
-          const Row row = run(o, p, grid(p, lay.px, lay.py, lay.pz), lay.P, l);
+          const double l = gcfmm_test::deposition_width(n);
+          const Particles p =
+              periodic ? gcfmm_test::deposition(n, 1) : gcfmm_test::random_cube(n, 1, std::cbrt(double(n)));
+          const Row row = run(o, p, gcfmm_test::grid_partition(p, lay.px, lay.py, lay.pz), lay.P, l);
           if (lay.P == 1) memory_one = double(row.memory);
           char t[32] = "";
           if (lay.P == 1) std::snprintf(t, sizeof t, "%.2f", row.seconds);

@@ -14,15 +14,18 @@
 // 1 rank), so the comparison tests the distributed near field and the summed node potentials;
 // the operator's accuracy is test_lattice_sum's business.
 // P ranks against 1 rank: both are within `accuracy` of the same reference, so their
-// difference is within 2 x accuracy by the triangle inequality; it is asked to be within
-// `accuracy` (the request), which holds because most of the error (the local-local lists of
-// dense regions) is common to both and the rest is bounded separately.
+// difference is within 2 x accuracy by the triangle inequality. It is asked to be within
+// `accuracy` (the request), which is tighter than that guarantee: a regression bound on the
+// measured agreement (about a third of the request at 1e-4, printed by the test), not a proof;
+// a failure of it alone (with the bounds against the direct sum holding) would mean the two
+// errors have become aligned, not that either result is out of tolerance.
 // P = 1 against Solver: bit-identical (the same phases on the same tree; the collectives are
 // the identity on one rank).
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -77,15 +80,7 @@ std::vector<int> partition(const Particles &p, int P, Split split, unsigned seed
   }
   int px, py, pz;
   grid_of(P, split, px, py, pz);
-  const auto [xlo, xhi] = std::minmax_element(p.x.begin(), p.x.end());
-  const auto [ylo, yhi] = std::minmax_element(p.y.begin(), p.y.end());
-  const auto [zlo, zhi] = std::minmax_element(p.z.begin(), p.z.end());
-  auto cell = [](double v, double lo, double hi, int n) {
-    return std::min(n - 1, static_cast<int>(n * (v - lo) / (hi - lo + 1e-300)));
-  };
-  for (std::size_t i = 0; i < p.size(); ++i)
-    rank[i] = (cell(p.x[i], *xlo, *xhi, px) * py + cell(p.y[i], *ylo, *yhi, py)) * pz + cell(p.z[i], *zlo, *zhi, pz);
-  return rank;
+  return gcfmm_test::grid_partition(p, px, py, pz);
 }
 
 struct RankRun {
@@ -107,14 +102,7 @@ RankRun distributed(const Options &o, const Particles &p, const std::vector<int>
     const int r = comm.rank();
     Particles mine;
     std::vector<std::int64_t> ids;
-    for (std::size_t i = 0; i < p.size(); ++i)
-      if (rank[i] == r) {
-        mine.x.push_back(p.x[i]);
-        mine.y.push_back(p.y[i]);
-        mine.z.push_back(p.z[i]);
-        mine.q.push_back(p.q[i]);
-        ids.push_back(static_cast<std::int64_t>(i));
-      }
+    gcfmm_test::rank_share(p, rank, r, mine, ids);
     DistributedSolver s(o, comm);
     if (o.boundary == Boundary::Periodic2D) s.set_box(0.0, 0.0, l, l);
     Field f(mine.size());
@@ -217,6 +205,8 @@ void check_all_partitions(const Options &o, const Particles &p, double l, const 
       EXPECT_LE(e1, acc) << what << " P = " << P << " " << name(split) << " against P = 1";
       EXPECT_LE(gcfmm_test::potential_error(r.f, ref), acc) << what << " P = " << P << " " << name(split);
       for (int k = 1; k < P; ++k) EXPECT_EQ(r.calls[k], r.calls[0]) << "the same collectives on every rank";
+      if (o.farfield != FarField::Average || o.boundary == Boundary::Free)
+        EXPECT_EQ(r.u, r.f.pot) << "energy potential = pot without the average far field";
       std::size_t let = 0;
       for (const auto &st : r.stats) let += st.let_nodes_received;
       EXPECT_GT(let, 0u) << "LETs were exchanged";
@@ -368,10 +358,13 @@ TEST(Distributed, PeriodicNoFarField) {
                        gcfmm_test::deposition_width(2500), {2, 3, 4, 8}, "periodic none");
 }
 
+// (every rank of every run sets up its far-field operator: fewer P under the sanitizer build)
 TEST(Distributed, PeriodicExactFarField) {
   const double l = gcfmm_test::deposition_width(2500);
+  const std::vector<int> ranks =
+      std::getenv("GCFMM_TEST_SMALL") ? std::vector<int>{3, 8} : std::vector<int>{2, 3, 4, 8};
   check_all_partitions(opts_of(1e-4, Boundary::Periodic2D, FarField::Exact), gcfmm_test::deposition(2500, 52), l,
-                       {2, 4, 8}, "periodic exact");
+                       ranks, "periodic exact");
 }
 
 TEST(Distributed, PeriodicAverageFarField) {
@@ -450,11 +443,7 @@ TEST(Distributed, CoincidentParticlesOnTwoRanks) {
         const int r = comm.rank();
         Particles mine;
         std::vector<std::int64_t> ids;
-        for (std::size_t i = 0; i < p.size(); ++i)
-          if (rank[i] == r) {
-            mine.x.push_back(p.x[i]), mine.y.push_back(p.y[i]), mine.z.push_back(p.z[i]), mine.q.push_back(p.q[i]);
-            ids.push_back(static_cast<std::int64_t>(i));
-          }
+        gcfmm_test::rank_share(p, rank, r, mine, ids);
         DistributedSolver s(o, comm);
         if (periodic) s.set_box(0.0, 0.0, l, l);
         Field f(mine.size());
@@ -482,11 +471,8 @@ TEST(Distributed, CoincidentParticlesOnTwoRanks) {
   gcfmm_test::run_ranks(2, [&](gcfmm_test::ThreadCommunicator &comm) {
     Particles mine;
     std::vector<std::int64_t> ids;
-    for (std::size_t i = 0; i < p.size(); ++i)
-      if (rank[i] == comm.rank()) {
-        mine.x.push_back(p.x[i]), mine.y.push_back(p.y[i]), mine.z.push_back(p.z[i]), mine.q.push_back(p.q[i]);
-        ids.push_back(static_cast<std::int64_t>(i) + 1000);
-      }
+    gcfmm_test::rank_share(p, rank, comm.rank(), mine, ids);
+    for (auto &id : ids) id += 1000;
     DistributedSolver s(opts_of(1e-4, Boundary::Free), comm);
     Field f(mine.size());
     try {

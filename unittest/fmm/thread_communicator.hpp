@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdint>
 #include <cstdlib>
 #include <condition_variable>
 #include <cstddef>
@@ -17,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "fmm_test_util.hpp"
 #include "gcfmm/communicator.hpp"
 
 namespace gcfmm_test {
@@ -105,6 +107,37 @@ class ThreadCommunicator final : public gcfmm::Communicator {
   int rank_;
   std::size_t calls_ = 0;
 };
+
+//! The particles of `rank` (owner[i] == rank) and their ids (their indices in p).
+inline void rank_share(const Particles &p, const std::vector<int> &owner, int rank, Particles &mine,
+                       std::vector<std::int64_t> &ids) {
+  mine = Particles{};
+  ids.clear();
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (owner[i] == rank) {
+      mine.x.push_back(p.x[i]);
+      mine.y.push_back(p.y[i]);
+      mine.z.push_back(p.z[i]);
+      mine.q.push_back(p.q[i]);
+      ids.push_back(static_cast<std::int64_t>(i));
+    }
+}
+
+//! The rank of every particle for a px x py x pz grid of ranks over the particles' bounding
+//! box (rank (ix py + iy) pz + iz); px x py x 1 is LAMMPS' `processors * * 1`.
+inline std::vector<int> grid_partition(const Particles &p, int px, int py, int pz) {
+  std::vector<int> rank(p.size(), 0);
+  if (p.size() == 0) return rank;
+  const auto [xlo, xhi] = std::minmax_element(p.x.begin(), p.x.end());
+  const auto [ylo, yhi] = std::minmax_element(p.y.begin(), p.y.end());
+  const auto [zlo, zhi] = std::minmax_element(p.z.begin(), p.z.end());
+  auto cell = [](double v, double lo, double hi, int n) {
+    return std::min(n - 1, static_cast<int>(n * (v - lo) / (hi - lo + 1e-300)));
+  };
+  for (std::size_t i = 0; i < p.size(); ++i)
+    rank[i] = (cell(p.x[i], *xlo, *xhi, px) * py + cell(p.y[i], *ylo, *yhi, py)) * pz + cell(p.z[i], *zlo, *zhi, pz);
+  return rank;
+}
 
 //! Runs f(comm) on P threads, one ThreadCommunicator each; rethrows the first rank's
 //! exception (in rank order) after all threads have joined.

@@ -66,7 +66,6 @@ struct DistributedSolver::Impl {
   Communicator &comm;
   detail::SolverCore core;          // this rank's particles: tree, local lists, expansions, far field
   DistributedStats stats;
-  bool box_set = false;
   bool evaluated = false;           // the last evaluate() completed
   std::vector<std::int64_t> sorted_ids;  // ids in tree order
   std::vector<std::uint32_t> charged;  // nonzero charges per node of this rank's tree

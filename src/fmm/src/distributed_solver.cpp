@@ -42,41 +42,20 @@ class Deferred {
 }  // namespace
 
 DistributedSolver::DistributedSolver(const Options &opts, Communicator &comm) : impl_(new Impl(comm)) {
-  opts.validate();
   SolverCore &c = impl_->core;
-  c.opts = opts;
-  c.res = resolve(opts);
-  c.opts.order = c.res.order;
-  c.opts.theta = c.res.theta;
-  c.opts.leaf = c.res.leaf;
-  c.ops.reset(new Operators(c.res.order));
+  c.configure(opts);
   DistributedStats &s = impl_->stats;
-  s.order = c.res.order;
-  s.theta = c.res.theta;
-  s.leaf = c.res.leaf;
-  s.estimated_error = c.res.estimated_error;
+  s.order = c.stats.order;
+  s.theta = c.stats.theta;
+  s.leaf = c.stats.leaf;
+  s.estimated_error = c.stats.estimated_error;
 }
 
 DistributedSolver::~DistributedSolver() = default;
 
-void DistributedSolver::set_box(double xlo, double ylo, double lx, double ly) {
-  // the same checks and state as Solver::set_box
-  Solver check(impl_->core.opts);
-  check.set_box(xlo, ylo, lx, ly);
-  SolverCore &c = impl_->core;
-  c.x0 = xlo;
-  c.y0 = ylo;
-  c.lx = lx;
-  c.ly = ly;
-  impl_->box_set = true;
-}
+void DistributedSolver::set_box(double xlo, double ylo, double lx, double ly) { impl_->core.set_box(xlo, ylo, lx, ly); }
 
-void DistributedSolver::set_z_range(double zlo, double zhi) {
-  Solver check(impl_->core.opts);
-  check.set_z_range(zlo, zhi);
-  impl_->core.zhint_lo = zlo;
-  impl_->core.zhint_hi = zhi;
-}
+void DistributedSolver::set_z_range(double zlo, double zhi) { impl_->core.set_z_range(zlo, zhi); }
 
 const DistributedStats &DistributedSolver::stats() const { return impl_->stats; }
 const Options &DistributedSolver::options() const { return impl_->core.opts; }
@@ -200,7 +179,7 @@ void DistributedSolver::evaluate(std::size_t n, const double *x, const double *y
   SolverCore &c = I.core;
   Communicator &comm = I.comm;
   // known identically on every rank: may throw before the collectives
-  if (c.periodic() && !I.box_set) throw std::runtime_error("gcfmm: Periodic2D needs set_box() before evaluate()");
+  if (c.periodic() && !c.box_set) throw std::runtime_error("gcfmm: Periodic2D needs set_box() before evaluate()");
   Deferred deferred;
   if (n > 0 && (!x || !y || !z || !q || !ids || !pot || !ex || !ey || !ez)) {
     deferred.fail(std::make_exception_ptr(std::invalid_argument("gcfmm: evaluate() got a null array")));

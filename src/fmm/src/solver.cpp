@@ -6,20 +6,7 @@ namespace gcfmm {
 
 using namespace detail;
 
-Solver::Solver(const Options &opts) : impl_(new Impl) {
-  opts.validate();
-  impl_->opts = opts;
-  impl_->res = resolve(opts);
-  impl_->opts.order = impl_->res.order;
-  impl_->opts.theta = impl_->res.theta;
-  impl_->opts.leaf = impl_->res.leaf;
-  impl_->ops.reset(new Operators(impl_->res.order));
-  Stats &s = impl_->stats;
-  s.order = impl_->res.order;
-  s.theta = impl_->res.theta;
-  s.leaf = impl_->res.leaf;
-  s.estimated_error = impl_->res.estimated_error;
-}
+Solver::Solver(const Options &opts) : impl_(new Impl) { impl_->configure(opts); }
 
 Solver::~Solver() = default;
 
@@ -45,28 +32,9 @@ void Solver::partition(int part, int nparts, std::size_t &first, std::size_t &la
   last = r.end;
 }
 
-void Solver::set_box(double xlo, double ylo, double lx, double ly) {
-  if (impl_->opts.boundary != Boundary::Periodic2D)
-    throw std::invalid_argument("gcfmm: set_box() is only for Boundary::Periodic2D");
-  if (!(std::isfinite(xlo) && std::isfinite(ylo) && std::isfinite(lx) && std::isfinite(ly)) || !(lx > 0.0) ||
-      !(ly > 0.0))
-    throw std::invalid_argument("gcfmm: set_box() needs finite xlo, ylo and lx, ly > 0");
-  impl_->x0 = xlo;
-  impl_->y0 = ylo;
-  impl_->lx = lx;
-  impl_->ly = ly;
-  impl_->box_set = true;
-  impl_->built = false;
-}
+void Solver::set_box(double xlo, double ylo, double lx, double ly) { impl_->set_box(xlo, ylo, lx, ly); }
 
-void Solver::set_z_range(double zlo, double zhi) {
-  if (impl_->opts.boundary != Boundary::Periodic2D)
-    throw std::invalid_argument("gcfmm: set_z_range() is only for Boundary::Periodic2D");
-  if (!(std::isfinite(zlo) && std::isfinite(zhi)) || !(zhi >= zlo))
-    throw std::invalid_argument("gcfmm: set_z_range() needs finite zlo <= zhi");
-  impl_->zhint_lo = zlo;
-  impl_->zhint_hi = zhi;
-}
+void Solver::set_z_range(double zlo, double zhi) { impl_->set_z_range(zlo, zhi); }
 
 void Solver::build(std::size_t n, const double *x, const double *y, const double *z) {
   Impl &I = *impl_;

@@ -8,6 +8,43 @@ namespace gcfmm {
 
 using namespace detail;
 
+void SolverCore::configure(const Options &o) {
+  o.validate();
+  opts = o;
+  res = resolve(o);
+  opts.order = res.order;
+  opts.theta = res.theta;
+  opts.leaf = res.leaf;
+  ops.reset(new Operators(res.order));
+  stats.order = res.order;
+  stats.theta = res.theta;
+  stats.leaf = res.leaf;
+  stats.estimated_error = res.estimated_error;
+}
+
+void SolverCore::set_box(double xlo, double ylo, double cell_x, double cell_y) {
+  if (opts.boundary != Boundary::Periodic2D)
+    throw std::invalid_argument("gcfmm: set_box() is only for Boundary::Periodic2D");
+  if (!(std::isfinite(xlo) && std::isfinite(ylo) && std::isfinite(cell_x) && std::isfinite(cell_y)) ||
+      !(cell_x > 0.0) || !(cell_y > 0.0))
+    throw std::invalid_argument("gcfmm: set_box() needs finite xlo, ylo and lx, ly > 0");
+  x0 = xlo;
+  y0 = ylo;
+  lx = cell_x;
+  ly = cell_y;
+  box_set = true;
+  built = false;
+}
+
+void SolverCore::set_z_range(double zlo, double zhi) {
+  if (opts.boundary != Boundary::Periodic2D)
+    throw std::invalid_argument("gcfmm: set_z_range() is only for Boundary::Periodic2D");
+  if (!(std::isfinite(zlo) && std::isfinite(zhi)) || !(zhi >= zlo))
+    throw std::invalid_argument("gcfmm: set_z_range() needs finite zlo <= zhi");
+  zhint_lo = zlo;
+  zhint_hi = zhi;
+}
+
 // Positions of a periodic system are wrapped into the primary cell first; all positions are
 // then expressed in the length unit h (the cell's for Periodic2D, the particles' extent in
 // free space), so the tree, the lists and the expansions see coordinates of order 1.

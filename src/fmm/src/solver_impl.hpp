@@ -267,6 +267,11 @@ struct SolverCore {
     return r;
   }
 
+  // validated options, resolved order/theta/leaf, operators and the stats they fix
+  void configure(const Options &o);
+  // Solver::set_box() and set_z_range() (checks and state)
+  void set_box(double xlo, double ylo, double cell_x, double cell_y);
+  void set_z_range(double zlo, double zhi);
   // ---- build phases ----
   void build_tree(const double *x, const double *y, const double *z);
   // the two halves of build_tree(): h from the particles' extent (free) or the cell, then the

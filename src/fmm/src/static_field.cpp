@@ -343,13 +343,7 @@ void StaticSourceField::Impl::m2l() {
   for (std::size_t i = 0; i < tn.size(); ++i) {
     const std::uint32_t e0 = lists.m2l_offset[i], e1 = lists.m2l_offset[i + 1];
     if (e1 == e0) continue;
-    const Node &A = tn[i];
-    for (std::uint32_t e = e0; e < e1; ++e) {
-      const Interaction &it = lists.m2l[e];
-      batch_m[e - e0] = multipole.data() + static_cast<std::size_t>(it.source) * S;
-      batch_r[e - e0] = A.center - (sn[it.source].center + lists.shifts[it.shift]);
-    }
-    ops->m2l_batch(e1 - e0, batch_m.data(), batch_r.data(), local.data() + i * S);
+    m2l_entries(*ops, tn[i], lists, e0, e1, sn, multipole.data(), batch_m, batch_r, local.data() + i * S);
     has_local[i] = 1;
   }
 }
@@ -358,18 +352,9 @@ void StaticSourceField::Impl::m2l() {
 void StaticSourceField::Impl::p2p() {
   const auto &tn = ttree.nodes, &sn = stree.nodes;
   const auto &xs = ttree.xs, &ys = ttree.ys, &zs = ttree.zs;
-  for (std::size_t i = 0; i < tn.size(); ++i) {
-    const Node &A = tn[i];
-    for (std::uint32_t e = lists.p2p_offset[i]; e < lists.p2p_offset[i + 1]; ++e) {
-      const Interaction &it = lists.p2p[e];
-      const Node &B = sn[it.source];
-      const Vec3 &sh = lists.shifts[it.shift];
-      gcfmm::p2p(A.count(), xs.data() + A.begin, ys.data() + A.begin, zs.data() + A.begin, B.count(),
-                 stree.xs.data() + B.begin, stree.ys.data() + B.begin, stree.zs.data() + B.begin,
-                 sq.data() + B.begin, sh.x, sh.y, sh.z, tpot.data() + A.begin, tex.data() + A.begin,
-                 tey.data() + A.begin, tez.data() + A.begin, kCoincidenceRadius * kCoincidenceRadius);
-    }
-  }
+  for (std::size_t i = 0; i < tn.size(); ++i)
+    p2p_entries(lists, i, tn[i].begin, tn[i].end, xs.data(), ys.data(), zs.data(), sn, stree.xs.data(),
+                stree.ys.data(), stree.zs.data(), sq.data(), tpot.data(), tex.data(), tey.data(), tez.data());
 }
 
 // L2L (eq. (3.12)) down the target tree, L2P (eq. (3.13)) at its leaves.
