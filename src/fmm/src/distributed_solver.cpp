@@ -161,16 +161,13 @@ void DistributedSolver::Impl::remote_p2p_m2p() {
 }
 
 std::size_t DistributedSolver::Impl::memory_bytes() const {
-  const SolverCore &c = core;
-  std::size_t b = tree_bytes(c.tree) + lists_bytes(c.lists) + lists_bytes(remote) + let.memory_bytes();
-  for (const auto *v : {&c.scaled_x, &c.scaled_y, &c.scaled_z, &c.multipole, &c.local, &c.sorted_q, &c.sorted_pot,
-                        &c.sorted_ex, &c.sorted_ey, &c.sorted_ez, &c.sorted_average_pot, &c.leaf_prefix, &phi, &boxes})
-    b += vector_bytes(*v);
-  b += vector_bytes(c.has_local) + vector_bytes(c.batch_m) + vector_bytes(c.batch_r) + vector_bytes(c.coincident) +
-       vector_bytes(sorted_ids) + vector_bytes(charged);
+  // the own solver's state (SolverCore::memory_bytes), plus the remote lists, the received LETs,
+  // the far field's node potentials, the ranks' boxes and the exchange buffers
+  std::size_t b = core.memory_bytes() + lists_bytes(remote) + let.memory_bytes() + vector_bytes(phi) +
+                  vector_bytes(boxes) + vector_bytes(sorted_ids) + vector_bytes(charged);
   for (const auto *buffers : {&send, &recv})
     for (const auto &v : *buffers) b += vector_bytes(v);
-  return b + c.far.memory_bytes() + c.ops->size() * sizeof(double) * 3 * Operators::kBatch;
+  return b;
 }
 
 void DistributedSolver::evaluate(std::size_t n, const double *x, const double *y, const double *z, const double *q,
