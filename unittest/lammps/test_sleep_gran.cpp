@@ -250,9 +250,12 @@ TEST(FixSleepGran, CoulombSleepersAreAStaticSource)
   EXPECT_EQ(nsleep, 144.0);
   const auto fref = gather(ref, "f", 3);
   const double eref = ref.var("f_coul");
+  // with either solver: with solver distributed each rank adds the static field at its own
+  // awake atoms
+  for (const char *solver : {"replicated", "distributed"})
   for (double acc : {1e-4, 1e-6}) {
     Lmp l;
-    charged_spheres(l, fmt::format("fix coul all coul/fmm accuracy {} sleepers static", acc));
+    charged_spheres(l, fmt::format("fix coul all coul/fmm accuracy {} sleepers static solver {}", acc, solver));
     EXPECT_EQ(l.var("f_sleep[2]"), nsleep);
     const auto f = gather(l, "f", 3);
     // the sleepers' forces are zero in both (fix sleep/gran). The awake atoms' forces must meet
@@ -263,8 +266,8 @@ TEST(FixSleepGran, CoulombSleepersAreAStaticSource)
     // the static field); its accuracy with multipole translations is fmm.static_field's
     // (SplitPlusStaticEqualsWholeSolver) and the deposition's check (doc/fix_coul_fmm.md)
     const double err = rel_rms(f, fref);
-    std::printf("[ static sleepers ] accuracy %g: force error %.3g, energy error %.3g\n", acc, err,
-                std::abs(l.var("f_coul") / eref - 1.0));
+    std::printf("[ static sleepers, %s ] accuracy %g: force error %.3g, energy error %.3g\n", solver,
+                acc, err, std::abs(l.var("f_coul") / eref - 1.0));
     EXPECT_LT(err, acc);
     EXPECT_GT(err, 0.0) << "two different evaluations";
     // the energy sums pair energies (awake-awake, awake-sleeping, sleeping-sleeping); its
