@@ -119,7 +119,8 @@ def main():
                     help="only fix coul/fmm (first --fmm-acc) on these numbers of MPI ranks")
     ap.add_argument("--solver", nargs="+", default=["replicated"],
                     choices=["replicated", "distributed"],
-                    help="with --ranks: fix coul/fmm's solver keyword(s), each on every rank count")
+                    help="fix coul/fmm's solver keyword(s): with --ranks each on every rank count, "
+                         "otherwise the first one")
     args = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="gc-bench-")
     try:
@@ -142,8 +143,8 @@ def compare(args, tmp):
         rows.append((n, "fmm reference 1e-8", "-", t_ref, 0.0))
         for acc in args.fmm_acc:
             t, f = run(args.lmp, args.np, data, "fmm", acc, 2 * RP, steps, out(f"fmm{acc}"),
-                       args.repeat)
-            rows.append((n, f"fmm exact accuracy {acc}", acc, t, rel_rms(f, fref)))
+                       args.repeat, args.solver[0])
+            rows.append((n, f"fmm exact accuracy {acc} ({args.solver[0]})", acc, t, rel_rms(f, fref)))
             print(*rows[-1], flush=True)
         for acc in args.pppm_acc or ((1e-6, 1e-7, 1e-8) if n <= 20000 else (1e-6, 1e-7)):
             t, f = run(args.lmp, args.np, data, "pppm", acc, 5 * RP, steps, out(f"pppm{acc}"),
