@@ -149,7 +149,7 @@ void CoulFMMCollectives::allgather(const double *mine, std::size_t count, double
 }
 
 void CoulFMMCollectives::alltoallv(const std::vector<std::vector<unsigned char>> &send,
-                            std::vector<std::vector<unsigned char>> &recv)
+                                   std::vector<std::vector<unsigned char>> &recv)
 {
   std::vector<int> scount(nprocs), rcount(nprocs), sdispl(nprocs), rdispl(nprocs);
   double stotal = 0.0, rtotal = 0.0;
@@ -163,10 +163,11 @@ void CoulFMMCollectives::alltoallv(const std::vector<std::vector<unsigned char>>
   int too_large = (stotal > limit || rtotal > limit) ? 1 : 0, any = 0;
   MPI_Allreduce(&too_large, &any, 1, MPI_INT, MPI_MAX, world);
   if (any)
-    lmp->error->all(FLERR,
-               "Fix coul/fmm: a rank would exchange more than 2 GiB of local essential "
-               "tree in one evaluation (sent {:.3g}, received {:.3g} bytes here): use more ranks",
-               stotal, rtotal);
+    lmp->error->all(
+        FLERR,
+        "Fix coul/fmm: a rank would exchange more than 2 GiB of local essential "
+        "tree in one evaluation (sent {:.3g}, received {:.3g} bytes here): use more ranks",
+        stotal, rtotal);
   int soff = 0, roff = 0;
   for (int p = 0; p < nprocs; p++) {
     sdispl[p] = soff;

@@ -486,7 +486,8 @@ void CoulFMMEvaluator::record_diagnostics()
     maxima[1] = (double) solver->memory_bytes();
   }
   mpi.collectives.allreduce_max(maxima, 2);
-  mpi.collectives.take_received_bytes();    // the diagnostics' own reduction is not the evaluation's
+  mpi.collectives
+      .take_received_bytes();    // the diagnostics' own reduction is not the evaluation's
   diagnostics.m2l = sums[0];
   diagnostics.p2p = sums[1];
   diagnostics.bytes_received = maxima[0];

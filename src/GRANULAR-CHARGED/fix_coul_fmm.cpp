@@ -32,6 +32,7 @@
 #include <cmath>
 #include <exception>
 #include <map>
+#include <vector>
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
@@ -97,21 +98,13 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
     } else if (key == "extrapolate") {
       mts.extrapolate = utils::logical(FLERR, v, false, lmp) == 1;
     } else if (key == "farfield") {
-      if (v != "exact" && v != "average" && v != "none")
-        error->all(FLERR, iarg + 1, "Fix coul/fmm farfield must be exact, average or none, got {}",
-                   v);
-      opts->farfield = v == "exact"
-          ? gcfmm::FarField::Exact
-          : (v == "average" ? gcfmm::FarField::Average : gcfmm::FarField::None);
+      const gcfmm::FarField fields[] = {gcfmm::FarField::Exact, gcfmm::FarField::Average,
+                                        gcfmm::FarField::None};
+      opts->farfield = fields[one_of(iarg, {"exact", "average", "none"}, arg)];
     } else if (key == "sleepers") {
-      if (v != "static" && v != "full")
-        error->all(FLERR, iarg + 1, "Fix coul/fmm sleepers must be static or full, got {}", v);
-      sleepers_static = v == "static";
+      sleepers_static = one_of(iarg, {"static", "full"}, arg) == 0;
     } else if (key == "solver") {
-      if (v != "distributed" && v != "replicated")
-        error->all(FLERR, iarg + 1, "Fix coul/fmm solver must be distributed or replicated, got {}",
-                   v);
-      distributed = v == "distributed";
+      distributed = one_of(iarg, {"distributed", "replicated"}, arg) == 0;
     } else if (key == "bed") {
       opts->bed_zlo = utils::numeric(FLERR, v, false, lmp);
       opts->bed_zhi = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
@@ -129,6 +122,18 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
     if (what.rfind("gcfmm: ", 0) == 0) what = what.substr(7);
     error->all(FLERR, "Fix coul/fmm {}", what);
   }
+}
+
+// the position of keyword arg[iarg]'s value among `words`, or an error listing them
+int FixCoulFMM::one_of(int iarg, const std::vector<std::string> &words, char **arg)
+{
+  for (size_t k = 0; k < words.size(); k++)
+    if (words[k] == arg[iarg + 1]) return (int) k;
+  std::string list = words[0];
+  for (size_t k = 1; k < words.size(); k++)
+    list += (k + 1 < words.size() ? ", " : " or ") + words[k];
+  error->all(FLERR, iarg + 1, "Fix coul/fmm {} must be {}, got {}", arg[iarg], list, arg[iarg + 1]);
+  return -1;
 }
 
 FixCoulFMM::~FixCoulFMM()

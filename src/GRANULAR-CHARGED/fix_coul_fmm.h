@@ -23,6 +23,7 @@ FixStyle(coul/fmm,FixCoulFMM);
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace gcfmm {
 struct Options;
@@ -89,6 +90,7 @@ class FixCoulFMM : public Fix {
   double **eval_state;
 
   void parse_keywords(int narg, char **arg);
+  int one_of(int iarg, const std::vector<std::string> &words, char **arg);
   void check_boundary_and_options();
   void compute_field(bool with_slope);
   void advance_field();
