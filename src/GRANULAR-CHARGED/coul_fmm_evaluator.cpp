@@ -30,6 +30,7 @@
 #include "gcfmm/solver.hpp"
 
 #include <algorithm>
+#include <array>
 #include <exception>
 
 using namespace LAMMPS_NS;
@@ -294,6 +295,7 @@ bool CoulFMMEvaluator::evaluate_replicated(const std::function<bool(int)> &charg
   mpi.gather(charged, gathered);
   const size_t n = gathered.size();
   if (n == 0) return false;
+  diagnostics.charges = (double) n;
   result.assign(4 * n, 0.0);
   double *pot = result.data(), *ex = pot + n, *ey = pot + 2 * n, *ez = pot + 3 * n;
   double qpot = 0.0;    // sum q pot^sleepers over this rank's share
@@ -372,6 +374,7 @@ bool CoulFMMEvaluator::evaluate_distributed(const std::function<bool(int)> &char
   const size_t n = local.size();
   double total = (double) n;
   mpi.sum(&total, 1);
+  diagnostics.charges = total;
   if (total == 0.0) return false;
   result.assign(4 * n, 0.0);
   double *pot = result.data(), *ex = pot + n, *ey = pot + 2 * n, *ez = pot + 3 * n;
@@ -464,39 +467,31 @@ std::string CoulFMMEvaluator::guarded(const std::function<void()> &run,
 
 void CoulFMMEvaluator::record_diagnostics()
 {
-  double sums[2], maxima[2] = {mpi.collectives.take_received_bytes(), 0.0};
+  // gcfmm::Stats and gcfmm::DistributedStats name the parameters alike
+  auto parameters = [this](const auto &st) {
+    diagnostics.estimated_error = st.estimated_error;
+    diagnostics.order = st.order;
+    diagnostics.theta = st.theta;
+    diagnostics.leaf = st.leaf;
+    return std::array<double, 2>{(double) st.m2l_count, (double) st.p2p_pairs};
+  };
+  double maxima[2] = {mpi.collectives.take_received_bytes(), 0.0};
+  std::array<double, 2> counts;
   if (distributed) {
-    const auto &st = distributed_solver->stats();
-    diagnostics.estimated_error = st.estimated_error;
-    diagnostics.order = st.order;
-    diagnostics.theta = st.theta;
-    diagnostics.leaf = st.leaf;
-    sums[0] = (double) st.m2l_count;
-    sums[1] = (double) st.p2p_pairs;
-    maxima[1] = (double) st.memory_bytes;
-    mpi.sum(sums, 2);
+    counts = parameters(distributed_solver->stats());
+    maxima[1] = (double) distributed_solver->stats().memory_bytes;
+    mpi.sum(counts.data(), 2);    // each rank's own interactions
   } else {
-    const auto &st = solver->stats();
-    diagnostics.estimated_error = st.estimated_error;
-    diagnostics.order = st.order;
-    diagnostics.theta = st.theta;
-    diagnostics.leaf = st.leaf;
-    sums[0] = (double) st.m2l_count;    // the whole evaluation's, on every rank
-    sums[1] = (double) st.p2p_pairs;
+    counts = parameters(solver->stats());    // the whole evaluation's, on every rank
     maxima[1] = (double) solver->memory_bytes();
   }
   mpi.collectives.allreduce_max(maxima, 2);
-  mpi.collectives
-      .take_received_bytes();    // the diagnostics' own reduction is not the evaluation's
-  diagnostics.m2l = sums[0];
-  diagnostics.p2p = sums[1];
+  // the diagnostics' own reduction is not the evaluation's
+  mpi.collectives.take_received_bytes();
+  diagnostics.m2l = counts[0];
+  diagnostics.p2p = counts[1];
   diagnostics.bytes_received = maxima[0];
   diagnostics.solver_memory = maxima[1];
-  diagnostics.charges = distributed ? 0.0 : (double) gathered.size();
-  if (distributed) {
-    diagnostics.charges = (double) local.size();
-    mpi.sum(&diagnostics.charges, 1);
-  }
 }
 
 void CoulFMMEvaluator::log_parameters()
