@@ -144,9 +144,16 @@ def build_parser() -> argparse.ArgumentParser:
                        description=REPRODUCE_DESCRIPTION,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     _study_options(p, "reproduce", "deck variables for every run (e.g. --var theta_crit 0.04)")
-    p.add_argument("--quick", action="store_true",
-                   help="N = 200 in L = 9 r_p instead of N = 500 in L = 14 r_p, charges 0 200 "
-                        "300 400 450, Table 2 at 400 only")
+    p.add_argument("--size", choices=["demo", "quick", "paper"], default="demo",
+                   help="demo: N = 500 in L = 14 r_p (default); quick: N = 200 in L = 9 r_p, "
+                        "charges 0 200 300 400 450, Table 2 at 400 only; paper: N = 2000 in "
+                        "L = 28 r_p, the paper's cases (sweep --preset paper and neutral cases "
+                        "to Ad = 20) with the deck's default protocols (many CPU hours)")
+    p.add_argument("--quick", action="store_const", const="quick", dest="size",
+                   help="the same as --size quick")
+    p.add_argument("--finished-only", action="store_true",
+                   help="run nothing: the tables, claims and figures of the runs finished in "
+                        "--out so far (a study that grows over several sittings)")
 
     p = sub.add_parser("demo", parents=[common],
                        help="the reduced Fig. 2 study: runs, table, Table 2, figures",
@@ -188,7 +195,7 @@ def _refused(command: str) -> dict:
     if command == "reproduce":
         # the study's cases set these; N by its size
         own.update({k: "reproduce sets it per case" for k in ("rp", "U0", "gamma", "q")},
-                   N="reproduce sets it (500, or 200 with --quick)")
+                   N="reproduce sets it (--size)", L_rp="reproduce sets it (--size)")
     if command in ("demo", "reproduce"):
         own["tracer"] = "use --tracer" if command == "demo" else "reproduce follows none"
     return dict(RESERVED, **own)
@@ -308,8 +315,9 @@ def cmd_reproduce(a) -> int:
     from .reproduce import Reproduction, report
     from .runner import Runner
     fields, extra = _vars(a, "reproduce")
-    study = Reproduction(out=_out_dir(a.out), quick=a.quick, seeds=tuple(a.seeds), extra=extra,
-                         fields=fields, jobs=a.jobs, progress=a.progress)
+    study = Reproduction(out=_out_dir(a.out), size_name=a.size, seeds=tuple(a.seeds),
+                         extra=extra, fields=fields, jobs=a.jobs, progress=a.progress,
+                         finished_only=a.finished_only)
     for p in study.params(True):
         Runner.check(p, study.tracer(p))
     res = study.run(_runner(a, not a.no_render))

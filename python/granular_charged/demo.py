@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
-from . import paper, tables
+from . import claims, paper, tables
 from .params import DepositionParams
 from .study import Study
 
@@ -22,8 +22,7 @@ from .study import Study
 # deck's default plane rain gives (doc/deposition.md, "Protocol checks")
 STUDY_INJECTION = MappingProxyType({"inject": "rain", "gap_rp": 1})   # read-only
 DEMO_VARS = MappingProxyType({"L_rp": 14, **STUDY_INJECTION})        # read-only
-FULL_COMMAND = ("granular-charged sweep --preset paper --N 2000 --seeds 1 2 3 "
-                "--out paper-results --figures paper-figures")
+FULL_COMMAND = "granular-charged reproduce --size paper --jobs 2 --out paper-size"
 
 
 @dataclass
@@ -44,8 +43,8 @@ class Demo(Study):
     def tracer(self, p: DepositionParams) -> int:
         return (self.follow or self.N // 2) if p.seed == self.seeds[0] else 0
 
-    def analyse(self, runs, summary, out) -> dict:
-        return {"slopes": tables.expansion_slope(summary)}
+    def analyse(self, runs, summary, out, results) -> dict:
+        return {"fits": tables.expansion_fits(runs)}
 
 
 def report(res: dict, study: Demo) -> str:
@@ -58,15 +57,16 @@ def report(res: dict, study: Demo) -> str:
         f"floor area), H = {study.extra.get('H_rp', 160)} r_p, seeds "
         f"{', '.join(map(str, study.seeds))}",
         "",
-        tables.format_table(s[["q", "runs", "phi", "phi_sd", "Z", "Z_sd", "Ad", "Estar", "Adstar",
-                               "expansion", "N", "lost", "wall_s"]]),
+        tables.format_table(tables.readable(s[["q", "runs", "phi", "phi_sd", "Z", "Z_sd", "Ad",
+                                               "Estar", "Adstar", "expansion", "expansion_se",
+                                               "N", "lost", "wall_s"]]), "{:.3g}"),
         "",
         f"paper: neutral phi_0 = {paper.PHI0_RANGE[0]}-{paper.PHI0_RANGE[1]}; charge lowers phi "
         f"and <Z>; phi_0/phi - 1 ~ q^{paper.EXPANSION_SLOPE:g}, up to {paper.MAX_RELATIVE_DECREASE:g}",
     ]
-    if not res["slopes"].empty:
-        lines.append("log-log slope of phi_0/phi - 1 vs q (paper 2): " + ", ".join(
-            f"{v:.2f} ({n} points)" for v, n in zip(res["slopes"]["slope"], res["slopes"]["points"])))
+    for fit in res["fits"]:
+        lines.append(f"log-log slope of phi_0/phi - 1 vs q (paper {paper.EXPANSION_SLOPE:g}): "
+                     + tables.describe_fit(fit))
     if res["table2"] is not None:
         lines += ["", "charged after formation (the paper's Table 2; relaxation 100 r_p/U0):",
                   tables.format_table(res["table2"][["q", "phi_before", "phi_after", "Z_before",
@@ -76,7 +76,8 @@ def report(res: dict, study: Demo) -> str:
               + (", table2/table2.csv" if res["table2"] is not None else ""),
               f"figures ({len(res['figures'])} PNG, each with its CSV): {res['out']}/figures",
               f"this was REDUCED (N = {study.N}, L = {study.extra.get('L_rp')} r_p, "
-              f"{len(study.seeds)} seeds); the full paper set (hours) is:",
+              f"{len(study.seeds)} seed{'s' if len(study.seeds) > 1 else ''}); the paper-size "
+              "study (many CPU hours, resumable; doc/data/README.md) is:",
               f"  {FULL_COMMAND}"]
     if not res["have_fmm"]:
         lines.append("NOTE: the charged cases (q != 0) were NOT run: they need fix coul/fmm")
@@ -98,12 +99,17 @@ def claims_report(res: dict) -> str:
                      f"{t['dZ'].abs().max():.2g} (paper: 2e-4 and 0)")
     neutral = s[s["q"] == 0]
     if not neutral.empty:
-        lines.append(f"neutral phi_0 (ours): {', '.join(f'{v:.4f}' for v in neutral['phi'])} "
-                     f"(paper: {paper.PHI0_RANGE[0]}-{paper.PHI0_RANGE[1]})")
+        lines.append("neutral phi_0 (ours): " + ", ".join(
+            tables.with_uncertainty(v, e) for v, e in zip(neutral["phi"], neutral["phi_sd"]))
+            + f" (paper: {paper.PHI0_RANGE[0]}-{paper.PHI0_RANGE[1]})")
+    with_measures = claims.runs_with_measures(res["results"])
+    lines += [f"  {c}" for c in claims.claim_lines(with_measures)]
     ch = s[s["q"] > 0]
     if not ch.empty:
         lines.append("phi vs q (ours): " + ", ".join(
-            f"q = {q:g}: {p:.4f} (phi_0/phi - 1 = {e:+.3f})"
-            for q, p, e in zip(ch["q"], ch["phi"], ch["expansion"])))
+            f"q = {q:g}: {tables.with_uncertainty(p, sd)} (phi_0/phi - 1 = "
+            f"{tables.with_uncertainty(e, se, sig=1)})"
+            for q, p, sd, e, se in zip(ch["q"], ch["phi"], ch["phi_sd"], ch["expansion"],
+                                       ch["expansion_se"])))
     return "\n".join(lines)
 

@@ -23,7 +23,7 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from . import packing, paper, tables
+from . import measures, packing, paper, tables
 from .params import jkr_scales, pair_modulus
 
 log = logging.getLogger(__name__)
@@ -224,7 +224,7 @@ def force_network(panels: list[tuple[str, Path, Path]], params: dict, out: Path,
     panels). panels: (title, final dump, forces dump) each."""
     loaded = []
     for title, fd, ff in panels:
-        if not (Path(fd).exists() and Path(ff).exists()):
+        if not (packing.dump_exists(fd) and packing.dump_exists(ff)):
             log.warning("figure %s: %s or %s missing", name, fd, ff)
             return None
         loaded.append((title, *read_pair_forces(fd, ff)))
@@ -274,7 +274,7 @@ def phi_vs_q(results, out: Path):
     ax.legend(fontsize=6)
     p1 = save(fig, Path(out) / "phi_vs_q.png", s)
 
-    sl = tables.expansion_slope(s)
+    fits = {tuple(f["series"]): f for f in tables.expansion_fits(tables.runs_frame(ok))}
     pos = s[(s["q"] > 0) & (s["expansion"] > 0)]
     fig = new_figure(5.2, 4.0)
     ax = fig.add_subplot(111)
@@ -292,11 +292,17 @@ def phi_vs_q(results, out: Path):
         ax.set_ylabel("phi_0 / phi - 1")
         ax.legend(fontsize=6)
         return p1, save(fig, Path(out) / "expansion_loglog.png", s)
+    rows = []
     for key, g in pos.groupby(["rp_um", "U0", "gamma_mJ"]):
-        m = sl[(sl[["rp_um", "U0", "gamma_mJ"]] == key).all(axis=1)]
-        slope = float(m["slope"].iloc[0]) if len(m) else float("nan")
-        lbl = _label(key) + (f": fitted slope {slope:.2f}" if np.isfinite(slope) else "")
-        ax.loglog(g["q"], g["expansion"], "o", label=lbl)
+        f = fits.get(tuple(float(v) for v in key))
+        # a slope only where the rule of tables.expansion_fit allows one
+        lbl = _label(key) + (f": slope {f['slope']:.1f} ({f['p16']:.1f}-{f['p84']:.1f})"
+                             if f and f["resolved"] else f": slope {tables.NOT_RESOLVED}")
+        ax.errorbar(g["q"], g["expansion"], g["expansion_se"].fillna(0), fmt="o", capsize=3,
+                    label=lbl)
+        rows.append(dict(zip(["rp_um", "U0", "gamma_mJ"], key),
+                         slope=f["slope"] if f else np.nan, p16=f.get("p16") if f else np.nan,
+                         p84=f.get("p84") if f else np.nan))
         # the paper's slope 2 through the geometric centre of our points
         lq, le = np.log10(g["q"]).mean(), np.log10(g["expansion"]).mean()
         qq = np.array([g["q"].min() / 1.5, g["q"].max() * 1.5])
@@ -307,7 +313,10 @@ def phi_vs_q(results, out: Path):
     ax.set_xlabel("q / e0")
     ax.set_ylabel("phi_0 / phi - 1")
     ax.legend(fontsize=6)
-    p2 = save(fig, Path(out) / "expansion_loglog.png", pos.merge(sl, how="left"))
+    ax.set_yscale("log")
+    ax.set_xscale("log")
+    p2 = save(fig, Path(out) / "expansion_loglog.png",
+              pos.merge(pd.DataFrame(rows), how="left") if rows else pos)
     return p1, p2
 
 
@@ -416,19 +425,16 @@ def force_pdf(panels: list[tuple[str, Path]], params: dict, out: Path, name="for
     """pdf of the normal contact forces F_n / F_C (Fig. 7) of forces dumps (compute pair/local:
     signed normal force, > 0 compressive), pairs in contact only; the paper's range |F_n/F_C|
     < 0.1 marked. panels: (label, forces dump) each."""
-    FC = jkr_scales(params["rp"] / 2, pair_modulus(params["E"], params["nu"]), params["gamma"])["FC"]
     fig = new_figure(5.2, 4.0)
     ax = fig.add_subplot(111)
     edges = np.linspace(-0.2, 0.2, bins + 1)
     c = 0.5 * (edges[1:] + edges[:-1])
     data = {"Fn_over_FC": c}
     for label, path in panels:
-        if not Path(path).exists():
+        if not packing.dump_exists(path):
             log.warning("figure %s: %s missing", name, path)
             return None
-        s = packing.read_dump(path, last_only=True)
-        f = s.cols["c_pl[2]"]
-        v = f[f != 0.0] / FC
+        v = measures.normal_forces(path, params)
         h, _ = np.histogram(v, bins=edges, density=True)
         ax.plot(c, h, label=f"{label} ({len(v)} contacts, mean {v.mean():+.4f})")
         data[f"pdf {label}"] = h
@@ -445,7 +451,7 @@ def tracer_energy(results, out: Path):
     """Kinetic energy of an incident particle vs its gap to the nearest earlier particle (Fig. 8).
     The bed is taken from the final configuration (particles with smaller id, which arrived
     before the tracer: hit-and-stick keeps them where they were when the tracer came)."""
-    runs = [r for r in results if r.get("tracer") and (Path(r["dir"]) / "tracer.dump").exists()]
+    runs = [r for r in results if r.get("tracer") and packing.dump_exists(Path(r["dir"]) / "tracer.dump")]
     if not runs:
         log.warning("figure tracer_energy: no run with a tracer particle")
         return None
@@ -454,30 +460,12 @@ def tracer_energy(results, out: Path):
     frames = []
     for r in sorted(runs, key=lambda r: r["params"]["q"]):
         p = r["params"]
-        tid = r["tracer"]
-        tr = [s for s in packing.read_dump(Path(r["dir"]) / "tracer.dump") if s.n == 1]
-        fin = packing.read_dump(Path(r["dir"]) / "final.dump", last_only=True)
-        bed = fin["id"] < tid
-        if not tr:
+        t = measures.tracer_approach(Path(r["dir"]), r)
+        if t is None:
             continue
-        pos = np.array([[s["x"][0], s["y"][0], s["z"][0]] for s in tr])
-        vel = np.array([[s["vx"][0], s["vy"][0], s["vz"][0]] for s in tr])
-        d = pos[:, None, :] - np.column_stack([fin["x"][bed], fin["y"][bed], fin["z"][bed]])[None]
-        d[..., 0] -= fin.lx * np.round(d[..., 0] / fin.lx)
-        d[..., 1] -= fin.ly * np.round(d[..., 1] / fin.ly)
-        # gap to the nearest earlier particle or to the floor (z = 0), whichever is closer
-        near = (np.sqrt((d * d).sum(-1)).min(axis=1) if bed.any()
-                else np.full(len(pos), np.inf))
-        gaps = np.minimum(near - 2 * p["rp"], pos[:, 2] - p["rp"]) / p["rp"]
-        m = 4.0 / 3.0 * math.pi * p["rp"] ** 3 * p["rho"]
-        eks = 0.5 * m * (vel * vel).sum(1) / (0.5 * m * p["U0"] ** 2)
-        # first contact: the first jump of E_k between samples (> 1 % of E_k0; in free flight,
-        # gravity and the Coulomb field change it by ~1e-4 per sample). The gap is measured to
-        # the final positions of the earlier particles, which may have moved since
-        jumps = np.flatnonzero(np.abs(np.diff(eks)) > 0.01)
-        k = int(jumps[0]) + 1 if len(jumps) else len(eks) - 1
-        line, = ax.plot(gaps[: k + 1], eks[: k + 1], label=f"q = {p['q']:g} e0 (particle {tid}): "
-                        f"E_k/E_k0 = {eks[k - 1]:.3f} before the first contact")
+        gaps, eks, k = t
+        line, = ax.plot(gaps[: k + 1], eks[: k + 1], label=f"q = {p['q']:g} e0 (particle "
+                        f"{r['tracer']}): E_k/E_k0 = {eks[k - 1]:.3f} before the first contact")
         ax.plot(gaps[k - 1], eks[k - 1], "o", color=line.get_color())
         frames.append(pd.DataFrame({"q": p["q"], "gap_over_rp": gaps, "Ek_over_Ek0": eks}))
     ax.axvline(0, color="grey", ls="--", lw=0.8)

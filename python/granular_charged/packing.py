@@ -7,8 +7,10 @@ are the Python reference for the package's computes ``packing/slab``, ``coord/di
 """
 from __future__ import annotations
 
+import gzip
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -40,11 +42,27 @@ class Snapshot:
         return float(self.box[1, 1] - self.box[1, 0])
 
 
+def read_text(path) -> str:
+    """A text file, or its gzip-compressed copy path.gz when path itself is absent (the run
+    folders kept in the repository are compressed, doc/data/README.md)."""
+    path = Path(path)
+    if not path.exists() and path.with_name(path.name + ".gz").exists():
+        with gzip.open(path.with_name(path.name + ".gz"), "rt") as fh:
+            return fh.read()
+    return path.read_text()
+
+
+def dump_exists(path) -> bool:
+    """The dump or its compressed copy (read_text) is there."""
+    path = Path(path)
+    return path.exists() or path.with_name(path.name + ".gz").exists()
+
+
 def read_dump(path, last_only=False):
-    """Read a LAMMPS text dump (custom or local). Returns a list of Snapshot (or the last)."""
+    """Read a LAMMPS text dump (custom or local; path or path.gz, read_text). Returns a list of
+    Snapshot (or the last)."""
     snaps = []
-    with open(path) as fh:
-        lines = fh.read().split("\n")
+    lines = read_text(path).split("\n")
     i, n = 0, len(lines)
     while i < n:
         if not lines[i].startswith("ITEM: TIMESTEP"):

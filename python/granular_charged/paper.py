@@ -60,5 +60,6 @@ CLAIMS = (
      "NOT covered: the g_2(r, Z) model of Liu et al. 2015 (Eqs. 9-10) is not implemented; the "
      "ALP point is drawn beside our points only"),
     ("The paper's sizes (N = 2000, L = 28 r_p) and 3 r_p slices of full packings",
-     "NOT covered by the demo (N = 500, L = 14 r_p); `sweep --preset paper` runs them"),
+     "NOT covered by the demo (N = 500, L = 14 r_p); `reproduce --size paper` runs them "
+     "(doc/reproduction.md, paper-size column)"),
 )

@@ -22,30 +22,60 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import paper, tables
+from . import claims, paper, tables
 from .demo import STUDY_INJECTION
 from .params import DepositionParams
 from .study import Study
+from .sweep import PAPER_SETS, expand
 
 CHARGES = (0.0, 100.0, 200.0, 260.0, 300.0, 400.0, 450.0)
 QUICK_CHARGES = (0.0, 200.0, 300.0, 400.0, 450.0)      # --quick: fewer charges, same range
 # neutral cases that move Ad away from the Fig. 2 case's 2, each by one parameter
 NEUTRAL_CASES = ({"U0": 0.5}, {"U0": 0.707}, {"U0": 1.414}, {"U0": 2.0},
                  {"gamma": 0.005}, {"gamma": 0.02}, {"rp": 1.0e-6})
-SIZES = {"full": {"N": 500, "L_rp": 14}, "quick": {"N": 200, "L_rp": 9}}
+SIZES = {"demo": {"N": 500, "L_rp": 14}, "quick": {"N": 200, "L_rp": 9},
+         "paper": {"N": 2000, "L_rp": 28}}
+# --size paper: the preset's cases (sweep.PAPER_SETS) and neutral ones that take Ad* over the
+# paper's Fig. 9 range (0.5 ... >= 20), each by one parameter from the Fig. 2 case
+PAPER_AD_SETS = (dict(rp=2e-6, U0=2.0, gamma=0.010, q=0),      # Ad = 0.5
+                 dict(rp=2e-6, U0=1.0, gamma=0.050, q=0),      # Ad = 10
+                 dict(rp=2e-6, U0=1.0, gamma=0.100, q=0))      # Ad = 20
+
+
+def paper_size_params(seeds, extra: dict, fields: dict) -> list[DepositionParams]:
+    """The paper-size study (N = 2000, L = 28 r_p, the deck's default protocols), in the order
+    it runs: every neutral case first (the cheapest runs, the phi_0 question and the Ad* line),
+    then the charged ones series by series, the largest charge first (the largest effect, the
+    first resolved). The deck's own L_rp is the paper's 28, so it is not set: the run folders
+    are those of `sweep --preset paper --N 2000`."""
+    ps = expand(PAPER_SETS + PAPER_AD_SETS, SIZES["paper"]["N"], seeds, extra, fields)
+    order = {id(p): k for k, p in enumerate(ps)}
+    series = []
+    for p in ps:
+        if (p.rp, p.U0, p.gamma) not in series:
+            series.append((p.rp, p.U0, p.gamma))
+    return sorted(ps, key=lambda p: (p.q > 0, series.index((p.rp, p.U0, p.gamma)) if p.q else 0,
+                                     -p.q, order[id(p)]))
 
 
 @dataclass
 class Reproduction(Study):
     """The paper's scaling claims at reduced size (the skeleton is :meth:`Study.run`)."""
-    quick: bool = False
+    size_name: str = "demo"
     charges: tuple = CHARGES
 
     @property
+    def quick(self) -> bool:
+        return self.size_name == "quick"
+
+    @property
     def size(self) -> dict:
-        return SIZES["quick" if self.quick else "full"]
+        return SIZES[self.size_name]
 
     def params(self, have_fmm: bool) -> list[DepositionParams]:
+        if self.size_name == "paper":
+            return [p for p in paper_size_params(self.seeds, self.extra, self.fields)
+                    if have_fmm or p.q == 0]
         extra = {"L_rp": self.size["L_rp"], **STUDY_INJECTION, **self.extra}
         N = self.size["N"]
         charges = QUICK_CHARGES if self.quick else self.charges
@@ -55,34 +85,52 @@ class Reproduction(Study):
                for case in NEUTRAL_CASES for s in self.seeds]
         return ps
 
+    def tracer(self, p: DepositionParams) -> int:
+        # paper size: the incident particle's E_k/E_k0 (Fig. 8) in the first seed of each case
+        return p.N // 2 if self.size_name == "paper" and p.seed == self.seeds[0] else 0
+
     def table2_charges(self) -> tuple:
         return (0.0, 400.0) if self.quick else tuple(self.table2_qs)
 
-    def analyse(self, runs, summary, out) -> dict:
-        fit = tables.expansion_fit(runs)
+    def analyse(self, runs, summary, out, results) -> dict:
+        fits = tables.expansion_fits(runs)
+        with_measures = claims.runs_with_measures(results) if results else runs
+        claims.case_table(with_measures).to_csv(out / "cases.csv", index=False)
+        lines = claims.claim_lines(with_measures) if results else []
+        (out / "claims.txt").write_text("\n".join(lines) + "\n")
         collapse = tables.adstar_collapse(runs)
         collapse_mid = tables.adstar_collapse(runs, barrier_fraction=0.5)
         collapse.to_csv(out / "collapse.csv", index=False)
         collapse_mid.to_csv(out / "collapse_mean_barrier.csv", index=False)
-        (out / "expansion_fit.json").write_text(json.dumps(fit, indent=1))
-        return {"fit": fit, "collapse": collapse, "collapse_mid": collapse_mid}
+        (out / "expansion_fit.json").write_text(json.dumps(fits, indent=1))
+        return {"fits": fits, "claims": lines, "collapse": collapse, "collapse_mid": collapse_mid}
 
 
 def report(res: dict, study: Reproduction) -> str:
-    s, fit, c = res["summary"], res["fit"], res["collapse"]
+    s, c = res["summary"], res["collapse"]
     size = study.size
-    lines = [f"granular-charged reproduce{' --quick' if study.quick else ''}: N = {size['N']} in "
+    protocol = ("the deck's default protocols (neutral: rain, one particle per r_p of fall; "
+                "charged: plane rain)" if study.size_name == "paper"
+                else "one particle per r_p of fall")
+    lines = [f"granular-charged reproduce --size {study.size_name}: N = {size['N']} in "
              f"L = {size['L_rp']} r_p (paper: N = 2000 in L = 28 r_p), seeds "
-             f"{', '.join(map(str, study.seeds))}, one particle per r_p of fall", "",
-             tables.format_table(s[["rp_um", "U0", "gamma_mJ", "q", "runs", "phi", "phi_sd", "Z",
-                                    "Z_sd", "Ad", "Estar", "Adstar", "expansion"]]), ""]
-    if fit.get("points", 0) >= 2:
-        lines.append(f"phi_0/phi - 1 vs q (r_p = 2 um, U_0 = 1 m/s): log-log slope "
-                     f"{fit['slope']:.2f}, bootstrap over seeds {fit['boot_mean']:.2f} +- "
-                     f"{fit['sd']:.2f} (16-84%: {fit['p16']:.2f} .. {fit['p84']:.2f}) from "
-                     f"{fit['points']} charges with a positive expansion (paper: "
-                     f"{paper.EXPANSION_SLOPE:g}); largest expansion "
-                     f"{s['expansion'].max():.3f} (paper: up to {paper.MAX_RELATIVE_DECREASE:g})")
+             f"{', '.join(map(str, study.seeds))}, {protocol}", "",
+             tables.format_table(tables.readable(s[["rp_um", "U0", "gamma_mJ", "q", "runs", "phi",
+                                                    "phi_sd", "Z", "Z_sd", "Ad", "Estar",
+                                                    "Adstar", "expansion", "expansion_se"]]),
+                                 "{:.3g}"), ""]
+    if res.get("missing"):
+        lines.append(f"{res['missing']} of the study's runs are not finished (--finished-only)")
+    for f in res["fits"]:
+        rp, u0, g = f["series"]
+        lines.append(f"phi_0/phi - 1 vs q (r_p = {rp:g} um, U_0 = {u0:g} m/s, gamma = {g:g} "
+                     f"mJ/m^2): log-log slope {tables.describe_fit(f)} (paper: "
+                     f"{paper.EXPANSION_SLOPE:g})")
+    if s["expansion"].notna().any():
+        k = s["expansion"].idxmax()
+        lines.append(f"largest phi_0/phi - 1: {tables.with_uncertainty(s.loc[k, 'expansion'], s.loc[k, 'expansion_se'], sig=1)}"
+                     f" at q = {s.loc[k, 'q']:g} e0, r_p = {s.loc[k, 'rp_um']:g} um, U_0 = "
+                     f"{s.loc[k, 'U0']:g} m/s (paper: up to {paper.MAX_RELATIVE_DECREASE:g})")
     for name, c in (("Ad* (the paper's: the mean barrier of a one-at-a-time deposition)", c),
                     ("Ad* with half that barrier (E*/2: the rain's charge in flight halves it)",
                      res["collapse_mid"])):
@@ -96,11 +144,13 @@ def report(res: dict, study: Reproduction) -> str:
             f"{(ch['phi_dev'] ** 2).mean() ** 0.5:.1f}; mean charged phi - line "
             f"{(ch['phi'] - ch['phi_line']).mean():+.4f}, <Z> - line "
             f"{(ch['Z'] - ch['Z_line']).mean():+.3f}")
+    lines += ["", "The paper's claims, ours beside its numbers (mean +- sd over the seeds):"]
+    lines += [f"  - {c}" for c in res["claims"]]
     if res["table2"] is not None:
         t = res["table2"]
         lines.append(f"Table 2: max |phi_after - phi_before| = {t['dphi'].abs().max():.2g}, "
                      f"max |<Z>_after - <Z>_before| = {t['dZ'].abs().max():.2g} (paper: 2e-4, 0)")
     lines += ["", f"tables: {res['out']}/summary.csv, runs.csv, collapse.csv, "
-              "expansion_fit.json; figures: " + f"{res['out']}/figures",
+              "expansion_fit.json, cases.csv, claims.txt; figures: " + f"{res['out']}/figures",
               f"wall time: {res['wall_s']:.0f} s"]
     return "\n".join(lines)

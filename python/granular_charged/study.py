@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import figures, tables
-from .after_formation import run_table2
+from .after_formation import load_table2, run_table2
 from .params import DepositionParams
 from .runner import RunError, Runner
 from .sweep import Sweep
@@ -37,6 +37,7 @@ class Study:
     fields: dict = field(default_factory=dict)   # DepositionParams fields for every run (rho, ...)
     jobs: int = 1
     progress: bool = True
+    finished_only: bool = False   # run nothing: analyse the runs finished in out so far
 
     # ---- what a study chooses ----------------------------------------------------------------
     def params(self, have_fmm: bool) -> list[DepositionParams]:
@@ -50,8 +51,9 @@ class Study:
     def table2_charges(self) -> tuple:
         return tuple(self.table2_qs)
 
-    def analyse(self, runs, summary, out: Path) -> dict:
-        """The study's own analyses of the runs (written under out); entries of run()'s result."""
+    def analyse(self, runs, summary, out: Path, results: list[dict]) -> dict:
+        """The study's own analyses of the runs (written under out); entries of run()'s result.
+        results: the runs' result dicts (with 'dir', their folders)."""
         return {}
 
     # ---- the same for every study -----------------------------------------------------------
@@ -63,20 +65,29 @@ class Study:
             log.warning("fix coul/fmm is NOT in this build: only the neutral cases run; the "
                         "charged cases need fix coul/fmm (they are not faked)")
         params = self.params(have_fmm)
-        results = Sweep(runner, out / "runs", jobs=self.jobs, progress=self.progress).run(
-            params, tracer=self.tracer)
+        if self.finished_only:
+            found = [runner.finished(p, out / "runs") for p in params]
+            results = [dict(r, dir=str(runner.workdir(p, out / "runs")))
+                       for p, r in zip(params, found) if r is not None]
+            log.info("%d of the study's %d runs are finished in %s (--finished-only: nothing "
+                     "is run)", len(results), len(params), out / "runs")
+        else:
+            results = Sweep(runner, out / "runs", jobs=self.jobs, progress=self.progress).run(
+                params, tracer=self.tracer)
         runs = tables.runs_frame(results)
         summ = tables.summary(runs)
         runs.drop(columns=["dir"]).to_csv(out / "runs.csv", index=False)
         summ.to_csv(out / "summary.csv", index=False)
         res = {"out": out, "results": results, "runs": runs, "summary": summ,
-               "have_fmm": have_fmm, **self.analyse(runs, summ, out)}
+               "have_fmm": have_fmm, **self.analyse(runs, summ, out, results)}
         t2 = []
         formed = sorted((r for r in results
                          if all(r["params"][k] == v for k, v in FIG2_CASE.items())),
                         key=lambda r: r["params"]["seed"])
         qs = self.table2_charges()
-        if formed and have_fmm and qs:
+        if self.finished_only:
+            t2 = load_table2(out / "table2") if (out / "table2").is_dir() else []
+        elif formed and have_fmm and qs:
             # the Table 2 runs take the formed run's settings (run_table2)
             try:
                 t2 = run_table2(runner, Path(formed[0]["dir"]), qs, out / "table2",
@@ -87,4 +98,5 @@ class Study:
         res["figures"] = figures.all_figures(results, out / "figures", t2)
         res["wall_s"] = time.monotonic() - t0
         res["complete"] = len(results) == len(params)
+        res["missing"] = len(params) - len(results)
         return res

@@ -44,58 +44,122 @@ def summary(runs: pd.DataFrame) -> pd.DataFrame:
               Adstar=("Adstar", "first"), N=("natoms", "mean"), lost=("lost", "sum"),
               wall_s=("wall_s", "mean")))
     series = ["rp_um", "U0", "gamma_mJ"]
-    phi0 = s[s["q"] == 0].set_index(series)["phi"].rename("phi0")
-    s = s.join(phi0, on=series)
-    s["expansion"] = s["phi0"] / s["phi"] - 1.0
-    return s.drop(columns="phi0")
+    neutral = s[s["q"] == 0].set_index(series)
+    s = s.join(neutral["phi"].rename("phi0"), on=series)
+    s = s.join((neutral["phi_sd"] / np.sqrt(neutral["runs"])).rename("phi0_se"), on=series)
+    s["expansion"], s["expansion_se"] = expansion_and_se(
+        s["phi0"], s["phi0_se"], s["phi"], s["phi_sd"] / np.sqrt(s["runs"]))
+    s.loc[s["q"] == 0, "expansion_se"] = np.nan
+    return s.drop(columns=["phi0", "phi0_se"])
 
 
-def expansion_slope(s: pd.DataFrame) -> pd.DataFrame:
-    """Per series, the log-log slope of phi_0/phi - 1 vs q over the charged cases with a
-    positive expansion (NaN with fewer than two); the paper's is 2."""
-    out = []
-    for key, g in s[(s["q"] > 0) & (s["expansion"] > 0)].groupby(["rp_um", "U0", "gamma_mJ"]):
-        slope = (np.polyfit(np.log10(g["q"]), np.log10(g["expansion"]), 1)[0]
-                 if len(g) >= 2 else np.nan)
-        out.append(dict(zip(["rp_um", "U0", "gamma_mJ"], key), points=len(g), slope=slope,
-                        paper_slope=paper.EXPANSION_SLOPE))
-    return pd.DataFrame(out, columns=["rp_um", "U0", "gamma_mJ", "points", "slope", "paper_slope"])
+def expansion_and_se(phi0, phi0_se, phi, phi_se):
+    """phi_0/phi - 1 and its standard error from the standard errors of the two means
+    (first-order propagation; the seeds of the two cases are independent runs). NaN for a
+    mean of one seed, whose standard error is unknown."""
+    ratio = phi0 / phi
+    return ratio - 1.0, ratio * np.hypot(phi0_se / phi0, phi_se / phi)
+
+
+# a fitted log-log slope is printed only from this many charges whose expansion exceeds its
+# own standard error (fewer: "not resolved at this size")
+MIN_RESOLVED_CHARGES = 3
+NOT_RESOLVED = "not resolved at this size"
 
 
 def expansion_fit(runs: pd.DataFrame, series=(2.0, 1.0, 10.0), n_boot: int = 2000,
                   seed: int = 1) -> dict:
     """The log-log slope of phi_0/phi - 1 vs q for one series (r_p [um], U_0, gamma [mJ]),
-    with its uncertainty from the seeds: a bootstrap that redraws the seeds of every charge
-    (and of the neutral case) with replacement, recomputes the means and refits; charges whose
-    mean expansion is not positive are left out of that fit. Returns the slope of the
-    observed means, the bootstrap mean and standard deviation, the 16th-84th percentile range,
-    and the points used."""
+    from the charges whose mean expansion exceeds its standard error (summary's
+    expansion_se), and only when there are MIN_RESOLVED_CHARGES of them ("resolved"; else the
+    slope is NaN and "reason" says why). The uncertainty comes from the seeds: a bootstrap
+    that redraws the seeds of every charge (and of the neutral case) with replacement,
+    recomputes the means and refits those charges (a redraw in which one is no longer
+    positive fits without it, and one with fewer than two left is dropped). Returns the
+    slope of the observed means, the bootstrap mean and standard deviation, the 16th-84th
+    percentile range, the charges used and those left out as unresolved."""
     sel = runs[(runs["rp_um"] == series[0]) & (runs["U0"] == series[1]) &
                (runs["gamma_mJ"] == series[2])]
-    by_q = {q: g["phi"].to_numpy() for q, g in sel.groupby("q")}
-    if 0.0 not in by_q or len(by_q) < 3:
-        return {"slope": np.nan, "sd": np.nan, "points": 0}
+    base = {"slope": np.nan, "sd": np.nan, "points": 0, "resolved": False, "charges": [],
+            "unresolved": [], "series": list(series), "paper_slope": paper.EXPANSION_SLOPE}
+    by_q = {float(q): g["phi"].dropna().to_numpy() for q, g in sel.groupby("q")}
+    by_q = {q: v for q, v in by_q.items() if len(v)}
+    if 0.0 not in by_q:
+        return dict(base, reason="no neutral case in this series")
+
+    def mean_se(v):
+        return v.mean(), (v.std(ddof=1) / np.sqrt(len(v)) if len(v) > 1 else np.nan)
+
+    m0, se0 = mean_se(by_q[0.0])
+    charged = sorted(q for q in by_q if q > 0)
+    resolved = []
+    for q in charged:
+        e, se = expansion_and_se(m0, se0, *mean_se(by_q[q]))
+        if e > se:            # False for an unknown (NaN) standard error
+            resolved.append(q)
+    base.update(points=len(resolved), charges=resolved,
+                unresolved=[q for q in charged if q not in resolved])
+    if len(resolved) < MIN_RESOLVED_CHARGES:
+        return dict(base, reason=f"{len(resolved)} of {len(charged)} charges have phi_0/phi - 1 "
+                                 f"above its standard error; a slope needs {MIN_RESOLVED_CHARGES}")
+    by_q = {q: v for q, v in by_q.items() if q == 0 or q in resolved}
 
     def fit(means):
         q = np.array([k for k in means if k > 0])
         e = np.array([means[0.0] / means[k] - 1.0 for k in q])
         keep = e > 0
         if keep.sum() < 2:
-            return np.nan, int(keep.sum())
-        return float(np.polyfit(np.log10(q[keep]), np.log10(e[keep]), 1)[0]), int(keep.sum())
+            return np.nan
+        return float(np.polyfit(np.log10(q[keep]), np.log10(e[keep]), 1)[0])
 
-    slope, points = fit({q: v.mean() for q, v in by_q.items()})
+    slope = fit({q: v.mean() for q, v in by_q.items()})
     rng = np.random.default_rng(seed)
-    boots = []
-    for _ in range(n_boot):
-        b, _ = fit({q: rng.choice(v, size=len(v), replace=True).mean() for q, v in by_q.items()})
-        if np.isfinite(b):
-            boots.append(b)
-    boots = np.array(boots)
-    return {"slope": slope, "boot_mean": float(boots.mean()), "sd": float(boots.std(ddof=1)),
-            "p16": float(np.percentile(boots, 16)), "p84": float(np.percentile(boots, 84)),
-            "points": points, "charges": sorted(k for k in by_q if k > 0),
-            "paper_slope": paper.EXPANSION_SLOPE}
+    boots = np.array([b for b in (fit({q: rng.choice(v, size=len(v), replace=True).mean()
+                                       for q, v in by_q.items()}) for _ in range(n_boot))
+                      if np.isfinite(b)])
+    return dict(base, resolved=True, slope=slope, boot_mean=float(boots.mean()),
+                sd=float(boots.std(ddof=1)), p16=float(np.percentile(boots, 16)),
+                p84=float(np.percentile(boots, 84)))
+
+
+def expansion_fits(runs: pd.DataFrame, **kw) -> list[dict]:
+    """expansion_fit for every series (r_p, U_0, gamma) of the runs that has charged cases."""
+    keys = runs[runs["q"] > 0][["rp_um", "U0", "gamma_mJ"]].drop_duplicates()
+    return [expansion_fit(runs, tuple(float(v) for v in k), **kw)
+            for k in keys.itertuples(index=False)]
+
+
+def describe_fit(fit: dict) -> str:
+    """One line for a printed summary: the slope with its interval, or why there is none."""
+    if not fit["resolved"]:
+        return f"{NOT_RESOLVED} ({fit['reason']})"
+    return (f"{fit['slope']:.1f} (bootstrap over seeds 16-84%: {fit['p16']:.1f} .. "
+            f"{fit['p84']:.1f}) from q = {', '.join(f'{q:g}' for q in fit['charges'])} e0")
+
+
+def with_uncertainty(value: float, sd: float, sig: int = 2) -> str:
+    """'value +- sd' with sd to `sig` significant digits and value to the same decimal place
+    (a value without a finite, positive sd, e.g. of one seed: 3 significant digits)."""
+    if not np.isfinite(value):
+        return "-"
+    if not (np.isfinite(sd) and sd > 0):
+        return f"{value:.3g}"
+    decimals = max(0, sig - 1 - int(np.floor(np.log10(sd))))
+    return f"{value:.{decimals}f} +- {sd:.{decimals}f}"
+
+
+def readable(s: pd.DataFrame, cols=("phi", "Z")) -> pd.DataFrame:
+    """A summary for printing: each of cols as one 'mean +- sd' column (digits the seeds'
+    scatter allows) and the expansion with its standard error."""
+    out = s.copy()
+    for c in cols:
+        out[c] = [with_uncertainty(v, e) for v, e in zip(s[c], s[f"{c}_sd"])]
+        out = out.drop(columns=f"{c}_sd")
+    if "expansion" in s:
+        out["expansion"] = [("0" if q == 0 else with_uncertainty(v, e, sig=1))
+                            for q, v, e in zip(s["q"], s["expansion"], s["expansion_se"])]
+        out = out.drop(columns="expansion_se")
+    return out
 
 
 def adstar(runs: pd.DataFrame, barrier_fraction: float = 1.0) -> pd.Series:

@@ -172,6 +172,28 @@ def test_incident_particle_decelerated_by_charge(study):
     assert eq < 1.0 - 0.05
 
 
+def test_claims_measures_of_the_runs(study):
+    """demo --claims measured every run (measures.json) and printed the claims: the incident
+    particle's E_k/E_k0 before contact agrees with the bounds of the test above (neutral: gravity
+    only; charged: more than 5 % lost), the whole-bed phi lies below the slab's (the rough top
+    and the floor layer are looser), f(Z)'s populations and the force fractions are fractions."""
+    by_q = {r["params"]["q"]: json.loads((Path(r["dir"]) / "measures.json").read_text())
+            for r in results(study)}
+    assert 1.0 <= by_q[0.0]["Ek_before_contact"] <= 1.0025
+    assert by_q[Q]["Ek_before_contact"] < 0.95
+    for r in results(study):
+        m = by_q[r["params"]["q"]]
+        assert m["phi_bed_top"] < m["phi_bed_2z"] and m["phi_bed_top"] < r["phi"]
+        for k in ("fZ_1_2", "fZ_4_6", "Fn_inside", "Fn_tensile"):
+            assert 0.0 <= m[k] <= 1.0, k
+        assert np.isfinite(m["rdf_sqrt3"])
+    out = study["stdout"]
+    assert "g(r) peak area at r/2r_p = sqrt 3" in out and "f(Z): <Z>" in out
+    # one seed: no difference is called one, no slope is printed
+    assert "not resolved (fewer than 2 seeds)" in out
+    assert "log-log slope of phi_0/phi - 1 vs q (paper 2): not resolved at this size" in out
+
+
 def test_table2_charging_after_formation_changes_nothing(study):
     """The paper's Table 2 (F_C/F_E ~ 1e4: no contact breaks, no rearrangement). Against the
     q = 0 control (same restart, same relaxation): the same <Z> exactly and phi within 1e-4

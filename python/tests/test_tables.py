@@ -53,3 +53,55 @@ def test_adstar_collapse_measures_the_charged_offset():
     # half the barrier: Ad* = Ad / (1 - E*/2), Ad = 4.9 x 0.4
     half = tables.adstar_collapse(runs, barrier_fraction=0.5)
     assert abs(half[half["q"] > 0].iloc[0]["Adstar"] - 4.9 * 0.4 / 0.7) < 1e-12
+
+
+def _series(expansions, scatter, phi0=0.42, seeds=(1, 2, 3)):
+    """Runs of one series: for each charge, phi = phi0 / (1 + expansion), the seeds spread by
+    -scatter, 0, +scatter (so phi's sd is `scatter`)."""
+    rows = []
+    for q, e in expansions.items():
+        for s, d in zip(seeds, (-scatter, 0.0, scatter)):
+            rows.append((2.0, 1.0, 10.0, q, s, 2.0, phi0 / (1.0 + e) + d, 4.0))
+    return _runs(rows)
+
+
+def test_expansion_fit_leaves_out_charges_inside_the_noise():
+    # phi_0/phi - 1 = 0.006 at 260 e0 with phi's sd 0.01 over 3 seeds: its standard error is
+    # ~0.019 (sqrt(2) x 0.01 / sqrt(3) / 0.42), so 260 is unresolved; 300, 400, 450 are not
+    runs = _series({0.0: 0.0, 260.0: 0.006, 300.0: 0.06, 400.0: 0.12, 450.0: 0.16}, 0.01)
+    fit = tables.expansion_fit(runs)
+    assert fit["resolved"]
+    assert fit["charges"] == [300.0, 400.0, 450.0]
+    assert fit["unresolved"] == [260.0]
+    assert fit["p16"] <= fit["slope"] <= fit["p84"]
+
+
+def test_expansion_fit_refuses_a_slope_from_two_resolved_charges():
+    # the demo's case that printed "5.95 (2 points)": one expansion inside the noise
+    runs = _series({0.0: 0.0, 260.0: 0.006, 400.0: 0.09}, 0.01)
+    fit = tables.expansion_fit(runs)
+    assert not fit["resolved"] and np.isnan(fit["slope"])
+    assert "1 of 2 charges" in fit["reason"]
+    assert tables.describe_fit(fit).startswith(tables.NOT_RESOLVED)
+    # one seed per charge: no standard error, nothing resolved
+    one = runs[runs["seed"] == 2]
+    assert tables.expansion_fit(one)["points"] == 0
+
+
+def test_summary_expansion_standard_error():
+    runs = _series({0.0: 0.0, 400.0: 0.1}, 0.01)
+    runs = runs.assign(natoms=2000, lost=0, wall_s=1.0)
+    s = tables.summary(runs).set_index("q")
+    se = 0.01 / np.sqrt(3)
+    phi, phi0 = 0.42 / 1.1, 0.42
+    assert abs(s.loc[400.0, "expansion"] - 0.1) < 1e-12
+    assert abs(s.loc[400.0, "expansion_se"] - phi0 / phi * np.hypot(se / phi0, se / phi)) < 1e-12
+    assert np.isnan(s.loc[0.0, "expansion_se"])
+
+
+def test_with_uncertainty_prints_the_digits_the_scatter_allows():
+    assert tables.with_uncertainty(0.42594, 0.00151) == "0.4259 +- 0.0015"
+    assert tables.with_uncertainty(0.39012, 0.0100) == "0.390 +- 0.010"
+    assert tables.with_uncertainty(3.9402, 0.055) == "3.940 +- 0.055"
+    assert tables.with_uncertainty(0.0061, 0.019, sig=1) == "0.01 +- 0.02"
+    assert tables.with_uncertainty(0.40884, float("nan")) == "0.409"
