@@ -528,6 +528,54 @@ def _phase_diagram(df, out: Path):
     return save(fig, Path(out) / "phase_diagram_Z_phi.png", df.drop(columns=["dir"]), tight=False)
 
 
+# ---- the phi_0 question: conventions (doc/reproduction.md, "The phi_0 gap") ------------------
+
+CONVENTION_BARS = ((("phi", "slab"), ("phi_bed_top", "whole bed, H_p = highest top"),
+                    ("phi_bed_surface", "whole bed, H_p = mean surface")),
+                   (("Z", "slab"), ("Z_all", "all particles"),
+                    ("Z_all_floor", "all, floor contacts counted")))
+
+
+def conventions(results, out: Path):
+    """phi and <Z> of every neutral case by the conventions the paper leaves open (mean +- sd
+    over the seeds), beside the paper's neutral range of phi_0 and its Table 2 packing."""
+    from . import claims
+    neutral = [r for r in _ok(results) if r["params"]["q"] == 0]
+    if not neutral:
+        log.warning("figure conventions: no neutral run")
+        return None
+    t = claims.case_table(claims.runs_with_measures(neutral)).sort_values("Ad")
+    fig = new_figure(6.4, 6.0)
+    axes = fig.add_subplot(211), fig.add_subplot(212)
+    x = np.arange(len(t))
+    for ax, bars in zip(axes, CONVENTION_BARS):
+        w = 0.8 / len(bars)
+        for k, (col, name) in enumerate(bars):
+            ax.bar(x + (k - (len(bars) - 1) / 2) * w, t[col], w, yerr=t[f"{col}_sd"].fillna(0),
+                   capsize=2, label=name)
+        ax.set_xticks(x)
+        ax.set_xticklabels([f"{_label((a, b, c))}\nAd = {ad:.2g}" for a, b, c, ad in
+                            zip(t["rp_um"], t["U0"], t["gamma_mJ"], t["Ad"])], fontsize=5)
+    axes[0].axhspan(*paper.PHI0_RANGE, color="0.88", zorder=0,
+                    label=f"paper: phi_0 = {paper.PHI0_RANGE[0]}-{paper.PHI0_RANGE[1]}")
+    axes[0].axhline(paper.TABLE2[0][1], **PAPER_STYLE,
+                    label=f"paper Table 2 (2 um, 1 m/s): {paper.TABLE2[0][1]}")
+    axes[1].axhline(paper.TABLE2[0][2], **PAPER_STYLE,
+                    label=f"paper Table 2 (2 um, 1 m/s): {paper.TABLE2[0][2]}")
+    axes[0].set_ylabel("phi")
+    axes[1].set_ylabel("<Z>")
+    axes[0].set_ylim(0.2, None)
+    axes[1].set_ylim(2.0, None)
+    for ax in axes:
+        ax.legend(fontsize=5, ncol=2)
+    n = int(t["runs"].min())
+    fig.suptitle(f"neutral packings by convention, N = {int(neutral[0]['natoms'])}, "
+                 f">= {n} seed{'s' if n > 1 else ''} per case", fontsize=8)
+    cols = ["rp_um", "U0", "gamma_mJ", "Ad", "runs"] + [f"{c}{sfx}" for bars in CONVENTION_BARS
+                                                       for c, _ in bars for sfx in ("", "_sd")]
+    return save(fig, Path(out) / "conventions.png", t[cols])
+
+
 # ---- everything -----------------------------------------------------------------------------
 
 def all_figures(results, out: Path, table2_rows: list[dict] | None = None,
@@ -546,7 +594,8 @@ def all_figures(results, out: Path, table2_rows: list[dict] | None = None,
     paths.append(packings_panel(results, out))
     p = phi_vs_q(results, out)
     paths += list(p) if isinstance(p, tuple) else [p]
-    paths += [rdf(results, out), fZ(results, out), tracer_energy(results, out)]
+    paths += [rdf(results, out), fZ(results, out), tracer_energy(results, out),
+              conventions(results, out)]
     paths += list(vs_adstar(results, out))
     if ok:
         key, byq = _biggest_series(ok)

@@ -4,6 +4,7 @@ and one log line per finished run.
 
 The paper's full set (its Figs. 2, 3a-c, 5a-c, 9, 10; N = 2000, L = 28 r_p, hours):
   granular-charged sweep --preset paper --N 2000 --seeds 1 2 3 --out paper-results --figures paper-figures
+(`granular-charged reproduce --size paper` runs these and more neutral cases, then the claims).
 """
 from __future__ import annotations
 

@@ -220,7 +220,8 @@ def test_reproduce_prints_tables_and_claims(study):
 
 FIGURES = ("packings", "packing_q0_s1", "packing_q480_s1", "phi_vs_q", "expansion_loglog", "rdf",
            "fZ", "force_pdf", "tracer_energy", "phi_Z_vs_Adstar", "phase_diagram_Z_phi",
-           "force_network_deposition", "table2", "force_network", "force_pdf_table2")
+           "force_network_deposition", "table2", "force_network", "force_pdf_table2",
+           "conventions")
 
 
 @pytest.mark.parametrize("name", FIGURES)
