@@ -28,12 +28,15 @@ from .params import jkr_scales, pair_modulus
 
 log = logging.getLogger(__name__)
 
-MEASURES_VERSION = 1
-# g(r) peaks the paper names, in r / 2 r_p, and the half width of the window whose area above
-# the straight line between the window's edges is the peak's (the first shell at 1 is ~0.02
-# wide at these overlaps; the windows below stay clear of it and of each other)
+MEASURES_VERSION = 2
+# g(r) peaks the paper names, in r / 2 r_p; the peak's area is that of g in a window of half
+# width RDF_HALF_WIDTH above the straight line through the mean of g in the two flanks of width
+# RDF_FLANK beside it (means over bins, not single bins: one run's g(r) scatters by ~0.1 per
+# bin of 0.01). The windows and flanks stay clear of the contact peak at 1, of the peak at 2
+# and of each other.
 RDF_PEAKS = {"sqrt2": math.sqrt(2.0), "sqrt3": math.sqrt(3.0), "sqrt5": math.sqrt(5.0)}
 RDF_HALF_WIDTH = 0.06
+RDF_FLANK = 0.05
 RDF_BIN = 0.01          # bin width in r / 2 r_p
 FORCE_RANGE = 0.1       # the paper's |F_n / F_C| < 0.1 (paper.FORCE_RANGE)
 
@@ -63,15 +66,17 @@ def fz_populations(fZ) -> dict:
 
 
 def rdf_peak_areas(x: np.ndarray, g: np.ndarray) -> dict:
-    """Area of g above the straight line through its values at the window edges, for each peak
-    of RDF_PEAKS (x = r / 2 r_p, bin centres of equal width)."""
+    """Area of g in the window of each peak of RDF_PEAKS above the straight line through the
+    mean of g in its two flanks (x = r / 2 r_p, bin centres of equal width)."""
     dx = x[1] - x[0]
     out = {}
     for name, x0 in RDF_PEAKS.items():
         lo, hi = x0 - RDF_HALF_WIDTH, x0 + RDF_HALF_WIDTH
-        glo, ghi = np.interp(lo, x, g), np.interp(hi, x, g)
+        left = (x >= lo - RDF_FLANK) & (x < lo)
+        right = (x > hi) & (x <= hi + RDF_FLANK)
+        (xl, gl), (xr, gr) = (x[left].mean(), g[left].mean()), (x[right].mean(), g[right].mean())
         w = (x >= lo) & (x <= hi)
-        base = glo + (ghi - glo) * (x[w] - lo) / (hi - lo)
+        base = gl + (gr - gl) * (x[w] - xl) / (xr - xl)
         out[f"rdf_{name}"] = float(((g[w] - base) * dx).sum())
     return out
 
