@@ -321,8 +321,10 @@ def cmd_reproduce(a) -> int:
     for p in study.params(True):
         Runner.check(p, study.tracer(p))
     res = study.run(_runner(a, not a.no_render))
-    print(report(res, study))
-    return 0 if res["complete"] else 1
+    text = report(res, study)
+    (Path(res["out"]) / "report.txt").write_text(text + "\n")
+    print(text)
+    return 0 if res["complete"] or a.finished_only else 1
 
 
 def cmd_demo(a) -> int:

@@ -21,6 +21,7 @@ import json
 from dataclasses import dataclass
 
 import numpy as np
+import pandas as pd
 
 from . import claims, paper, tables
 from .demo import STUDY_INJECTION
@@ -93,10 +94,15 @@ class Reproduction(Study):
         return (0.0, 400.0) if self.quick else tuple(self.table2_qs)
 
     def analyse(self, runs, summary, out, results) -> dict:
+        if not results:      # --finished-only before the first run
+            return {"fits": [], "claims": [], "collapse": pd.DataFrame(),
+                    "collapse_mid": pd.DataFrame()}
         fits = tables.expansion_fits(runs)
-        with_measures = claims.runs_with_measures(results) if results else runs
-        claims.case_table(with_measures).to_csv(out / "cases.csv", index=False)
-        lines = claims.claim_lines(with_measures) if results else []
+        lines = []
+        if results:
+            with_measures = claims.runs_with_measures(results)
+            claims.case_table(with_measures).to_csv(out / "cases.csv", index=False)
+            lines = claims.claim_lines(with_measures)
         (out / "claims.txt").write_text("\n".join(lines) + "\n")
         collapse = tables.adstar_collapse(runs)
         collapse_mid = tables.adstar_collapse(runs, barrier_fraction=0.5)
@@ -126,8 +132,8 @@ def report(res: dict, study: Reproduction) -> str:
         lines.append(f"phi_0/phi - 1 vs q (r_p = {rp:g} um, U_0 = {u0:g} m/s, gamma = {g:g} "
                      f"mJ/m^2): log-log slope {tables.describe_fit(f)} (paper: "
                      f"{paper.EXPANSION_SLOPE:g})")
-    if s["expansion"].notna().any():
-        k = s["expansion"].idxmax()
+    if (s["q"] > 0).any() and s.loc[s["q"] > 0, "expansion"].notna().any():
+        k = s.loc[s["q"] > 0, "expansion"].idxmax()
         lines.append(f"largest phi_0/phi - 1: {tables.with_uncertainty(s.loc[k, 'expansion'], s.loc[k, 'expansion_se'], sig=1)}"
                      f" at q = {s.loc[k, 'q']:g} e0, r_p = {s.loc[k, 'rp_um']:g} um, U_0 = "
                      f"{s.loc[k, 'U0']:g} m/s (paper: up to {paper.MAX_RELATIVE_DECREASE:g})")
@@ -137,13 +143,16 @@ def report(res: dict, study: Reproduction) -> str:
         if "phi_dev" not in c or not c["phi_line"].notna().any():
             continue
         ch, ne = c[(c["q"] > 0) & np.isfinite(c["Adstar"])], c[c["q"] == 0]
+        charged = (f"charged cases {(ch['phi_dev'] ** 2).mean() ** 0.5:.1f}; mean charged phi - "
+                   f"line {(ch['phi'] - ch['phi_line']).mean():+.4f}, <Z> - line "
+                   f"{(ch['Z'] - ch['Z_line']).mean():+.3f}" if len(ch) else
+                   "no charged case finished")
         lines.append(
             f"collapse on {name}: deviation from the neutral cases' line phi(log Ad*) in "
             "standard errors of the mean, RMS: neutral cases "
-            f"{(ne['phi_dev'] ** 2).mean() ** 0.5:.1f}, charged cases "
-            f"{(ch['phi_dev'] ** 2).mean() ** 0.5:.1f}; mean charged phi - line "
-            f"{(ch['phi'] - ch['phi_line']).mean():+.4f}, <Z> - line "
-            f"{(ch['Z'] - ch['Z_line']).mean():+.3f}")
+            f"{(ne['phi_dev'] ** 2).mean() ** 0.5:.1f}, {charged}")
+        if not len(ch):
+            break     # the second barrier convention differs only for charged cases
     lines += ["", "The paper's claims, ours beside its numbers (mean +- sd over the seeds):"]
     lines += [f"  - {c}" for c in res["claims"]]
     if res["table2"] is not None:
@@ -151,6 +160,6 @@ def report(res: dict, study: Reproduction) -> str:
         lines.append(f"Table 2: max |phi_after - phi_before| = {t['dphi'].abs().max():.2g}, "
                      f"max |<Z>_after - <Z>_before| = {t['dZ'].abs().max():.2g} (paper: 2e-4, 0)")
     lines += ["", f"tables: {res['out']}/summary.csv, runs.csv, collapse.csv, "
-              "expansion_fit.json, cases.csv, claims.txt; figures: " + f"{res['out']}/figures",
+              "expansion_fit.json, cases.csv, claims.txt, report.txt; figures: " + f"{res['out']}/figures",
               f"wall time: {res['wall_s']:.0f} s"]
     return "\n".join(lines)

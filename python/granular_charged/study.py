@@ -60,6 +60,7 @@ class Study:
     def run(self, runner: Runner) -> dict:
         t0 = time.monotonic()
         out = Path(self.out).resolve()
+        out.mkdir(parents=True, exist_ok=True)
         have_fmm = runner.build.capabilities["coul/fmm"]
         if not have_fmm:
             log.warning("fix coul/fmm is NOT in this build: only the neutral cases run; the "

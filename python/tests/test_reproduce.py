@@ -1,0 +1,44 @@
+"""`reproduce --size paper`: the study's runs, their order and their folders, and a report of
+what is finished without running anything."""
+from granular_charged import paper
+from granular_charged.reproduce import SIZES, Reproduction, paper_size_params
+from granular_charged.sweep import PAPER_SETS, expand
+
+
+def test_paper_size_runs_are_the_sweep_presets_and_the_fig9_neutral_range():
+    ps = paper_size_params((1, 2, 3), {}, {})
+    keys = [p.key() for p in ps]
+    assert len(keys) == len(set(keys))
+    # every run of `sweep --preset paper --N 2000` is one of them, in the same folder
+    preset = {p.key() for p in expand(PAPER_SETS, 2000, (1, 2, 3), {})}
+    assert preset <= set(keys)
+    assert all(p.N == 2000 and "L_rp" not in p.extra for p in ps)     # the deck's L = 28 r_p
+    # neutral first (cheap, the phi_0 question), then the charged runs
+    charged = [p.q > 0 for p in ps]
+    assert charged == sorted(charged)
+    ad = sorted({round(p.groups()["Ad"], 3) for p in ps if p.q == 0})
+    assert ad[0] <= 0.5 and ad[-1] >= 20      # the paper's Fig. 9 range
+    # the three series of Fig. 3 have at least four charges each
+    for rp, u0 in ((1e-6, 1.0), (1e-6, 2.0), (2e-6, 1.0)):
+        qs = {p.q for p in ps if p.rp == rp and p.U0 == u0 and p.gamma == 0.010}
+        assert len(qs) >= 5 and 0 in qs
+    # the paper's particles per floor area at every size
+    for s in SIZES.values():
+        assert abs(s["N"] / s["L_rp"] ** 2 / (2000 / 28 ** 2) - 1) < 0.05
+
+
+def test_paper_size_follows_a_particle_in_the_first_seed_only():
+    st = Reproduction(out=".", size_name="paper")
+    ps = st.params(True)
+    assert {st.tracer(p) for p in ps if p.seed == 1} == {1000}
+    assert {st.tracer(p) for p in ps if p.seed != 1} == {0}
+
+
+def test_finished_only_runs_nothing(cli, tmp_path):
+    r = cli(["reproduce", "--size", "paper", "--finished-only", "--out", tmp_path / "o"],
+            cwd=tmp_path)
+    assert "0 of the study's 84 runs are finished" in r.stderr
+    assert "84 of the study's runs are not finished" in r.stdout
+    assert not list((tmp_path / "o").glob("runs/*/log.lammps"))
+    assert (tmp_path / "o" / "report.txt").exists()
+    assert paper.PHI0_RANGE
