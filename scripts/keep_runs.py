@@ -2,6 +2,7 @@
 one sitting grows over several (doc/data/README.md).
 
     /usr/bin/python3 scripts/keep_runs.py STUDY_OUT/runs doc/data/paper-size/runs
+    /usr/bin/python3 scripts/keep_runs.py --table2 STUDY_OUT/table2 doc/data/paper-size/table2
 
 Copies, for every run folder of SRC with a complete result.json that DST lacks: result.json,
 measures.json (computed here when missing), final.dump and forces.dump gzip-compressed (the
@@ -69,9 +70,42 @@ def keep(src: Path, dst: Path) -> int:
     return kept
 
 
+TABLE2_DUMPS = ("before.dump", "after.dump", "forces_before.dump", "forces_after.dump")
+
+
+def keep_table2(src: Path, dst: Path) -> int:
+    """The Table 2 runs (STUDY_OUT/table2/q*/): result.json and the four dumps, compressed."""
+    from granular_charged.after_formation import row_problem
+    import json
+    kept = 0
+    for run in sorted(src.glob("q*")):
+        try:
+            row = json.loads((run / "result.json").read_text())
+        except (OSError, ValueError):
+            continue
+        if row_problem(row) is not None or (dst / run.name / "result.json").exists():
+            continue
+        tmp = dst / f".{run.name}.tmp"
+        shutil.rmtree(tmp, ignore_errors=True)
+        tmp.mkdir(parents=True)
+        shutil.copy2(run / "result.json", tmp / "result.json")
+        for name in TABLE2_DUMPS:
+            if (run / name).exists():
+                with open(run / name, "rb") as fi, gzip.open(tmp / f"{name}.gz", "wb", 9) as fo:
+                    shutil.copyfileobj(fi, fo)
+        tmp.rename(dst / run.name)
+        kept += 1
+    return kept
+
+
 if __name__ == "__main__":
-    if len(sys.argv) != 3:
+    args = sys.argv[1:]
+    table2 = args[:1] == ["--table2"]
+    if table2:
+        args = args[1:]
+    if len(args) != 2:
         sys.exit(__doc__)
-    src, dst = Path(sys.argv[1]), Path(sys.argv[2])
+    src, dst = Path(args[0]), Path(args[1])
     dst.mkdir(parents=True, exist_ok=True)
-    print(f"kept {keep(src, dst)} new runs in {dst}")
+    n = keep_table2(src, dst) if table2 else keep(src, dst)
+    print(f"kept {n} new runs in {dst}")

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from . import measures, paper, tables
+from . import measures, packing, paper, tables
 from .tables import CASE, with_uncertainty
 
 SERIES = ["rp_um", "U0", "gamma_mJ"]
@@ -156,4 +156,27 @@ def claim_lines(runs: pd.DataFrame) -> list[str]:
         lines.append(f"(<Z>, phi) of {len(ok)} cases: phi = {c[1]:.3f} + {c[0]:.3f} <Z>, at <Z> = "
                      f"{paper.ALP_Z:g}: phi = {np.polyval(c, paper.ALP_Z):.3f} (paper's ALP limit "
                      f"{paper.ALP_PHI:g})")
+    return lines
+
+
+def table2_lines(rows: list[dict]) -> list[str]:
+    """The paper's Fig. 7 on its Table 2 packing: the normal-force pdf before and after charging
+    (width, the share inside |F_n/F_C| < 0.1, the shift of the mean to tension), one packing."""
+    from pathlib import Path
+    lines = []
+    for r in sorted(rows, key=lambda r: r["q"]):
+        if r["q"] == 0:
+            continue
+        d = Path(r["dir"])
+        if not (packing.dump_exists(d / "forces_before.dump") and
+                packing.dump_exists(d / "forces_after.dump")):
+            continue
+        b = measures.force_stats(measures.normal_forces(d / "forces_before.dump", r["params"]))
+        a = measures.force_stats(measures.normal_forces(d / "forces_after.dump", r["params"]))
+        lines.append(
+            f"Table 2 packing charged to {r['q']:g} e0 (one packing): F_n/F_C sd "
+            f"{b['Fn_sd']:.3f} -> {a['Fn_sd']:.3f}, inside |F_n/F_C| < {paper.FORCE_RANGE:g} "
+            f"{b['Fn_inside']:.3f} -> {a['Fn_inside']:.3f} (paper: all), mean "
+            f"{b['Fn_mean']:+.5f} -> {a['Fn_mean']:+.5f}, tensile share {b['Fn_tensile']:.3f} -> "
+            f"{a['Fn_tensile']:.3f} (paper: shifts to tension)")
     return lines

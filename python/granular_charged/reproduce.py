@@ -155,6 +155,7 @@ def report(res: dict, study: Reproduction) -> str:
             break     # the second barrier convention differs only for charged cases
     lines += ["", "The paper's claims, ours beside its numbers (mean +- sd over the seeds):"]
     lines += [f"  - {c}" for c in res["claims"]]
+    lines += [f"  - {c}" for c in claims.table2_lines(res.get("table2_rows") or [])]
     if res["table2"] is not None:
         t = res["table2"]
         lines.append(f"Table 2: max |phi_after - phi_before| = {t['dphi'].abs().max():.2g}, "

@@ -96,6 +96,7 @@ class Study:
             except RunError as e:
                 log.error("Table 2 check FAILED: %s", e)
         res["table2"] = tables.table2_frame(t2) if t2 else None
+        res["table2_rows"] = t2
         res["figures"] = figures.all_figures(results, out / "figures", t2)
         res["wall_s"] = time.monotonic() - t0
         res["complete"] = len(results) == len(params)
