@@ -291,3 +291,90 @@ TEST(InducedDipoles, BadInputIsRefused)
   s.electrode = true;
   EXPECT_THROW(solve_polarizable_direct(s, {}), std::invalid_argument);
 }
+
+// ---- dipoles in the expansions (doc/polarization.md, section 5) ------------------------------
+
+#include "gcfmm/expansions.hpp"
+
+namespace {
+
+struct Cluster {
+  std::vector<double> x, y, z, q, px, py, pz;
+};
+
+Cluster cluster(const Vec3 &c, double radius, std::size_t n, unsigned seed)
+{
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Cluster k;
+  while (k.x.size() < n) {
+    const Vec3 d{u(gen), u(gen), u(gen)};
+    if (norm2(d) > 1.0) continue;
+    k.x.push_back(c.x + radius * d.x);
+    k.y.push_back(c.y + radius * d.y);
+    k.z.push_back(c.z + radius * d.z);
+    k.q.push_back(u(gen));
+    k.px.push_back(u(gen));
+    k.py.push_back(u(gen));
+    k.pz.push_back(u(gen));
+  }
+  return k;
+}
+
+}  // namespace
+
+TEST(DipoleExpansions, MultipoleOfDipolesGivesTheirPotential)
+{
+  // order 14, sources within 0.5 of the centre, targets at distance 4: truncation ~(1/8)^15
+  const int order = 14;
+  Operators ops(order);
+  const Vec3 c{0.2, -0.1, 0.3};
+  const Cluster k = cluster(c, 0.5, 20, 3);
+  std::vector<double> M(ops.size(), 0.0);
+  ops.p2m_dipoles(k.x.size(), k.x.data(), k.y.data(), k.z.data(), k.px.data(), k.py.data(), k.pz.data(), c,
+                  M.data());
+  ops.symmetrize(M.data());
+  for (const Vec3 t : {Vec3{4.0, 0.3, -0.2}, Vec3{-1.0, 3.5, 2.0}, Vec3{0.5, 0.0, -4.1}}) {
+    PointField f;
+    for (std::size_t j = 0; j < k.x.size(); ++j)
+      add_dipole({k.px[j], k.py[j], k.pz[j]}, t - Vec3{k.x[j], k.y[j], k.z[j]}, f);
+    EXPECT_NEAR(ops.m2p_potential(M.data(), t - c), f.pot, 1e-11 * std::fabs(f.pot) + 1e-13);
+  }
+}
+
+TEST(DipoleExpansions, LocalExpansionGivesFieldGradient)
+{
+  // charges and dipoles in a source cluster (radius 0.5), M2L to a target centre at distance 4,
+  // targets within 0.5 of it: (r_s + r_t) / R = 1/4, truncation ~0.25^(p+1) = 2e-9 at p = 14
+  // relative to the field's scale; the gradient converges one order slower
+  const int order = 14;
+  Operators ops(order);
+  const Vec3 cs{0.0, 0.0, 0.0}, ct{3.0, 2.0, -1.5};   // |ct - cs| = 3.9
+  const Cluster k = cluster(cs, 0.5, 25, 5);
+  std::vector<double> M(ops.size(), 0.0), L(ops.size(), 0.0);
+  ops.p2m(k.x.size(), k.x.data(), k.y.data(), k.z.data(), k.q.data(), cs, M.data());
+  ops.p2m_dipoles(k.x.size(), k.x.data(), k.y.data(), k.z.data(), k.px.data(), k.py.data(), k.pz.data(), cs,
+                  M.data());
+  ops.symmetrize(M.data());
+  ops.m2l(M.data(), ct - cs, L.data());
+  ops.symmetrize(L.data());
+  const Cluster targets = cluster(ct, 0.5, 10, 9);
+  for (std::size_t i = 0; i < targets.x.size(); ++i) {
+    const Vec3 t{targets.x[i], targets.y[i], targets.z[i]};
+    PointField f;
+    for (std::size_t j = 0; j < k.x.size(); ++j) {
+      const Vec3 d = t - Vec3{k.x[j], k.y[j], k.z[j]};
+      add_charge(k.q[j], d, f);
+      add_dipole({k.px[j], k.py[j], k.pz[j]}, d, f);
+    }
+    double pot = 0, ex = 0, ey = 0, ez = 0, g[6] = {};
+    ops.l2p_gradient(L.data(), t - ct, pot, ex, ey, ez, g);
+    const double es = std::sqrt(norm2(f.e)), gs = std::fabs(f.g.xx) + std::fabs(f.g.zz) + std::fabs(f.g.xy);
+    EXPECT_NEAR(pot, f.pot, 1e-8 * std::fabs(f.pot));
+    EXPECT_NEAR(ex, f.e.x, 1e-7 * es);
+    EXPECT_NEAR(ey, f.e.y, 1e-7 * es);
+    EXPECT_NEAR(ez, f.e.z, 1e-7 * es);
+    const double want[6] = {f.g.xx, f.g.xy, f.g.xz, f.g.yy, f.g.yz, f.g.zz};
+    for (int a = 0; a < 6; ++a) EXPECT_NEAR(g[a], want[a], 1e-6 * gs) << "component " << a;
+  }
+}

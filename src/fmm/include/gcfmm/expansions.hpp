@@ -87,6 +87,17 @@ class Operators {
    *  result depends only on its own position (not on n or its place in the batch). */
   void l2p_batch(const double *L, const Vec3 &c, std::size_t n, const double *x, const double *y, const double *z,
                  double *pot, double *ex, double *ey, double *ez);
+  /** P2M of point dipoles (doc/polarization.md, eq. (5.1)): M_n^m += sum_j conj(p_j . grad
+   *  Y_n^m(y_j - c)) = sum_j sum_l conj(Y_{n-1}^{m-l}(y_j - c) Y_1^l(p_j)) (the addition theorem
+   *  (3.6) to first order), m >= 0 only. The multipole of a dipole has no monopole. */
+  void p2m_dipoles(std::size_t n, const double *x, const double *y, const double *z, const double *px,
+                   const double *py, const double *pz, const Vec3 &c, double *M);
+  /** L2P with the field gradient (doc/polarization.md, eq. (5.2)): the (full) local expansion
+   *  re-centred at r = x - z_t to degree 2 by (3.12); adds the potential, the field
+   *  E = (Re L'_1^1, Im L'_1^1, -L'_1^0) and the gradient G_ab = dE_a/dx_b from L'_2^m.
+   *  gxx, gxy, gxz, gyy, gyz, gzz: the six components of the symmetric G. */
+  void l2p_gradient(const double *L, const Vec3 &r, double &pot, double &ex, double &ey, double &ez,
+                    double *g6);
   /** M2P (for tests): potential of the (full) multipole at r = x - z_s (doc/theory.md, eq. (3.8)). */
   double m2p_potential(const double *M, const Vec3 &r);
   /** Batched M2P: adds the potential and field E = -grad phi of the (full) multipole about c
