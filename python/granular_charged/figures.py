@@ -554,7 +554,7 @@ def conventions(results, out: Path):
             ax.bar(x + (k - (len(bars) - 1) / 2) * w, t[col], w, yerr=t[f"{col}_sd"].fillna(0),
                    capsize=2, label=name)
         ax.set_xticks(x)
-        ax.set_xticklabels([f"{_label((a, b, c))}\nAd = {ad:.2g}" for a, b, c, ad in
+        ax.set_xticklabels([f"{a:g} um, {b:g} m/s\n{c:g} mJ/m2\nAd = {ad:.2g}" for a, b, c, ad in
                             zip(t["rp_um"], t["U0"], t["gamma_mJ"], t["Ad"])], fontsize=5)
     axes[0].axhspan(*paper.PHI0_RANGE, color="0.88", zorder=0,
                     label=f"paper: phi_0 = {paper.PHI0_RANGE[0]}-{paper.PHI0_RANGE[1]}")
