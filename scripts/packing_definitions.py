@@ -9,7 +9,7 @@ rattlers) and over all particles (with or without floor contacts). doc/reproduct
 import glob, sys, statistics as st
 import numpy as np
 sys.path.insert(0, str(__import__('pathlib').Path(__file__).resolve().parents[1] / 'python'))
-from granular_charged import packing
+from granular_charged import measures, packing
 
 rows = {}
 part = sys.argv[2] if len(sys.argv) > 2 else ''
@@ -17,10 +17,7 @@ for d in sorted(glob.glob(f'{sys.argv[1].rstrip("/")}/*/')):
     if part not in d or not glob.glob(d + 'result.json'):
         continue
     snap = packing.read_dump(d + 'final.dump', last_only=True)
-    rp = float(snap['radius'][0]); z = np.asarray(snap['z']); r = np.asarray(snap['radius'])
-    L = snap.box[0][1] - snap.box[0][0] if hasattr(snap, 'box') else None
-    Lx, Ly = snap.lx, snap.ly
-    vol = (4 / 3 * np.pi * r**3).sum()
+    rp = float(snap['radius'][0]); z = np.asarray(snap['z'])
     zlo, zhi = packing.analysis_slab(snap, rp)
     Z_all = packing.coordination(snap)
     inslab = (z >= zlo) & (z <= zhi)
@@ -32,17 +29,15 @@ for d in sorted(glob.glob(f'{sys.argv[1].rstrip("/")}/*/')):
             carry[int(a)] += 1; carry[int(b)] += 1
     ids = np.asarray(snap['id']).astype(int)
     Zf = carry[ids]
-    floor = z - r < 1e-3 * rp          # touching the floor wall
+    c = measures.conventions(snap, rp)      # the whole-bed measures have one home
     out = {
         'slab phi': packing.phi_slab(snap, zlo, zhi),
-        'whole bed phi, H = highest top': vol / (Lx * Ly * (z + r).max()),
-        'whole bed phi, H = 2<z>': vol / (Lx * Ly * 2 * z.mean()),
-        # an area-independent height: the mean over columns of 2 r_p x 2 r_p of the top sphere
-        'whole bed phi, H = mean surface height': vol / (Lx * Ly * np.nanmean(
-            packing.surface_heights(snap, 2 * rp))),
+        'whole bed phi, H = highest top': c['phi_bed_top'],
+        'whole bed phi, H = 2<z>': c['phi_bed_2z'],
+        'whole bed phi, H = mean surface height': c['phi_bed_surface'],
         'slab <Z> geometric': Z_all[inslab].mean(),
-        '<Z> all particles': Z_all.mean(),
-        '<Z> all, floor contacts counted': (Z_all + floor).mean(),
+        '<Z> all particles': c['Z_all'],
+        '<Z> all, floor contacts counted': c['Z_all_floor'],
         'slab <Z> force-carrying': Zf[inslab].mean(),
         'slab <Z> without rattlers (Z < 2)': Z_all[inslab & (Z_all >= 2)].mean(),
     }
