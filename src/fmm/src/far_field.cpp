@@ -18,34 +18,39 @@
 
 namespace gcfmm {
 
-void PeriodicFarField::interp_weights(double t, int p, const double *tab, double *s, double *ds) {
+void PeriodicFarField::interp_weights(double t, int p, const double *tab, double *s, double *ds, double *d2s) {
   // Lagrange basis of the first-kind Chebyshev nodes t_i = cos(pi (2i+1) / 2p), written with
   // the discrete orthogonality of T_k: S_i(t) = 1/p + (2/p) sum_{k=1}^{p-1} T_k(t_i) T_k(t),
   // S_i'(t) = (2/p) sum_k T_k(t_i) k U_{k-1}(t). Stable everywhere on [-1, 1] and slightly beyond.
-  double tk[32], dtk[32];
+  // Second derivatives by the differentiated recurrence T_k'' = 4 T_{k-1}' + 2 t T_{k-1}'' - T_{k-2}''.
+  double tk[32], dtk[32], d2tk[32];
   tk[0] = 1.0;
-  dtk[0] = 0.0;
+  dtk[0] = d2tk[0] = 0.0;
   if (p > 1) {
     tk[1] = t;
     dtk[1] = 1.0;
+    d2tk[1] = 0.0;
   }
   double um1 = 1.0, u = 2.0 * t;  // U_0, U_1
   for (int k = 2; k < p; ++k) {
     tk[k] = 2.0 * t * tk[k - 1] - tk[k - 2];
     dtk[k] = k * u;  // T_k' = k U_{k-1}
+    d2tk[k] = 4.0 * dtk[k - 1] + 2.0 * t * d2tk[k - 1] - d2tk[k - 2];
     const double un = 2.0 * t * u - um1;
     um1 = u;
     u = un;
   }
   for (int i = 0; i < p; ++i) {
     const double *ti = tab + static_cast<std::size_t>(i) * p;
-    double a = 0.5, b = 0.0;
+    double a = 0.5, b = 0.0, c = 0.0;
     for (int k = 1; k < p; ++k) {
       a += ti[k] * tk[k];
       b += ti[k] * dtk[k];
+      c += ti[k] * d2tk[k];
     }
     s[i] = 2.0 * a / p;
     if (ds) ds[i] = 2.0 * b / p;
+    if (d2s) d2s[i] = 2.0 * c / p;
   }
 }
 
@@ -194,6 +199,110 @@ void PeriodicFarField::interpolate(const double *phi, const double *x, const dou
     ey[i] -= fy * gy;
     ez[i] -= fz * gz;
   }
+}
+
+void PeriodicFarField::interpolate_gradient(const double *phi, const double *x, const double *y, const double *z,
+                                            std::size_t begin, std::size_t end, double *pot, double *ex,
+                                            double *ey, double *ez, double *g6) const {
+  const int p = pxy_, pz = pz_;
+  double sx[32], sy[32], sz[32], dsx[32], dsy[32], dsz[32], d2sx[32], d2sy[32], d2sz[32];
+  const double fx = 2.0 / lx_, fy = 2.0 / ly_, fz = 2.0 / hz_;
+  for (std::size_t i = begin; i < end; ++i) {
+    double tx, ty, tz;
+    const int b = locate(i, x[i], y[i], z[i], &tx, &ty, &tz);
+    interp_weights(tx, p, tab_xy_.data(), sx, dsx, d2sx);
+    interp_weights(ty, p, tab_xy_.data(), sy, dsy, d2sy);
+    interp_weights(tz, pz, tab_z_.data(), sz, dsz, d2sz);
+    const double *col = phi + static_cast<std::size_t>(b) * p * p * pz;
+    // derivatives of the interpolant in the reference coordinates t: f, f_x, ..., f_zz
+    double f = 0, gx = 0, gy = 0, gz = 0, hxx = 0, hxy = 0, hxz = 0, hyy = 0, hyz = 0, hzz = 0;
+    for (int a = 0; a < p; ++a) {
+      double fa = 0, fya = 0, fyya = 0, fza = 0, fyza = 0, fzza = 0;
+      for (int bb = 0; bb < p; ++bb) {
+        const double *src = col + (a * p + bb) * pz;
+        double v = 0, vz = 0, vzz = 0;
+        for (int c = 0; c < pz; ++c) {
+          v += sz[c] * src[c];
+          vz += dsz[c] * src[c];
+          vzz += d2sz[c] * src[c];
+        }
+        fa += sy[bb] * v;
+        fya += dsy[bb] * v;
+        fyya += d2sy[bb] * v;
+        fza += sy[bb] * vz;
+        fyza += dsy[bb] * vz;
+        fzza += sy[bb] * vzz;
+      }
+      f += sx[a] * fa;
+      gx += dsx[a] * fa;
+      hxx += d2sx[a] * fa;
+      gy += sx[a] * fya;
+      hxy += dsx[a] * fya;
+      hyy += sx[a] * fyya;
+      gz += sx[a] * fza;
+      hxz += dsx[a] * fza;
+      hyz += sx[a] * fyza;
+      hzz += sx[a] * fzza;
+    }
+    if (pot) pot[i] += f;
+    ex[i] -= fx * gx;
+    ey[i] -= fy * gy;
+    ez[i] -= fz * gz;
+    double *g = g6 + 6 * i;  // G = -Hessian of the potential
+    g[0] -= fx * fx * hxx;
+    g[1] -= fx * fy * hxy;
+    g[2] -= fx * fz * hxz;
+    g[3] -= fy * fy * hyy;
+    g[4] -= fy * fz * hyz;
+    g[5] -= fz * fz * hzz;
+  }
+}
+
+void PeriodicFarField::evaluate_dipoles(std::size_t n, const double *x, const double *y, const double *z,
+                                        const double *q, const double *px, const double *py, const double *pz,
+                                        std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
+                                        double *ez, double *g6) const {
+  if (!ready()) throw std::logic_error("gcfmm::PeriodicFarField::evaluate_dipoles: setup() not called");
+  if (end > n || begin > end)
+    throw std::invalid_argument("gcfmm::PeriodicFarField::evaluate_dipoles: bad target range");
+  const int p = pxy_, nz = pz_, nn = p * p * nz;
+  const double fx = 2.0 / lx_, fy = 2.0 / ly_, fz = 2.0 / hz_;
+  double sx[32], sy[32], sz[32], dsx[32], dsy[32], dsz[32];
+  std::vector<double> w(static_cast<std::size_t>(nn) * nb_, 0.0);
+  int src_lo = nb_, src_hi = 0, tgt_lo = nb_, tgt_hi = 0;
+  // node charges W_b = sum_j (q_j + p_j . grad_j) S_b(r_j): a dipole is the limit of two
+  // opposite charges, so its potential is p . grad_y R(x - y) and its weights p . grad S
+  for (std::size_t j = 0; j < n; ++j) {
+    double tx, ty, tz;
+    const int b = locate(j, x[j], y[j], z[j], &tx, &ty, &tz);
+    tgt_lo = std::min(tgt_lo, b);
+    tgt_hi = std::max(tgt_hi, b + 1);
+    const double qj = q ? q[j] : 0.0;
+    const double pxj = px ? px[j] : 0.0, pyj = py ? py[j] : 0.0, pzj = pz ? pz[j] : 0.0;
+    if (qj == 0.0 && pxj == 0.0 && pyj == 0.0 && pzj == 0.0) continue;
+    src_lo = std::min(src_lo, b);
+    src_hi = std::max(src_hi, b + 1);
+    interp_weights(tx, p, tab_xy_.data(), sx, dsx);
+    interp_weights(ty, p, tab_xy_.data(), sy, dsy);
+    interp_weights(tz, nz, tab_z_.data(), sz, dsz);
+    double *col = w.data() + static_cast<std::size_t>(nn) * b;
+    for (int a = 0; a < p; ++a) {
+      const double wa = qj * sx[a] + pxj * fx * dsx[a];  // the part without a y or z derivative
+      const double wya = pyj * fy * sx[a], wza = pzj * fz * sx[a];
+      for (int bb = 0; bb < p; ++bb) {
+        const double c0 = wa * sy[bb] + wya * dsy[bb], cz = wza * sy[bb];
+        double *dst = col + (a * p + bb) * nz;
+        for (int c = 0; c < nz; ++c) dst[c] += c0 * sz[c] + cz * dsz[c];
+      }
+    }
+  }
+  if (src_hi <= src_lo) return;
+  Eigen::MatrixXd phi(nn, nb_);
+  apply(w.data(), phi.data(), src_lo, src_hi, tgt_lo, tgt_hi);
+  if (g6)
+    interpolate_gradient(phi.data(), x, y, z, begin, end, pot, ex, ey, ez, g6);
+  else
+    interpolate(phi.data(), x, y, z, begin, end, pot, ex, ey, ez);
 }
 
 double PeriodicFarField::sample_error() const {

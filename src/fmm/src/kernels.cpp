@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "gcfmm/dipole_kernels.hpp"
 #include "simd_paths.hpp"
 
 #if GCFMM_X86_DISPATCH
@@ -224,6 +225,42 @@ void direct_images(std::size_t n, const double *x, const double *y, const double
   for (int nx = -images; nx <= images; ++nx)
     for (int ny = -images; ny <= images; ++ny)
       p2p(n, x, y, z, n, x, y, z, q, nx * lx, ny * ly, 0.0, pot, ex, ey, ez);
+}
+
+void p2p_dipoles(std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
+                 const double *xs, const double *ys, const double *zs, const double *qs, const double *pxs,
+                 const double *pys, const double *pzs, double sx, double sy, double sz, double *pot, double *ex,
+                 double *ey, double *ez, double *g6, double r2_min) {
+  for (std::size_t i = 0; i < nt; ++i) {
+    const Vec3 ti{xt[i] - sx, yt[i] - sy, zt[i] - sz};
+    PointField f;
+    for (std::size_t j = 0; j < ns; ++j) {
+      const Vec3 d{ti.x - xs[j], ti.y - ys[j], ti.z - zs[j]};
+      if (norm2(d) <= r2_min) continue;
+      const Vec3 p{pxs[j], pys[j], pzs[j]};
+      const bool dipole = p.x != 0.0 || p.y != 0.0 || p.z != 0.0;
+      if (g6) {
+        if (qs[j] != 0.0) add_charge(qs[j], d, f);
+        if (dipole) add_dipole(p, d, f);
+      } else {
+        if (qs[j] != 0.0) add_charge_field(qs[j], d, f.pot, f.e);
+        if (dipole) add_dipole_field(p, d, f.pot, f.e);
+      }
+    }
+    pot[i] += f.pot;
+    ex[i] += f.e.x;
+    ey[i] += f.e.y;
+    ez[i] += f.e.z;
+    if (g6) {
+      double *g = g6 + 6 * i;
+      g[0] += f.g.xx;
+      g[1] += f.g.xy;
+      g[2] += f.g.xz;
+      g[3] += f.g.yy;
+      g[4] += f.g.yz;
+      g[5] += f.g.zz;
+    }
+  }
 }
 
 }  // namespace gcfmm

@@ -76,8 +76,11 @@ inline double length_unit(double extent) {
 // sweep suffices. Shared by Solver, StaticSourceField and the received LETs of
 // DistributedSolver; for the last, `given` flags the leaves whose multipole is already in
 // `multipole` (received, not computed: no P2M, not zeroed; the caller zeroes all other nodes).
+// With dipoles (px, py, pz in tree order, not null) their P2M (doc/polarization.md, eq. (5.1))
+// is added at the leaves.
 inline void upward_pass(const Tree &tree, const double *q, Operators &ops, std::vector<double> &multipole,
-                        const std::vector<char> *given = nullptr) {
+                        const std::vector<char> *given = nullptr, const double *px = nullptr,
+                        const double *py = nullptr, const double *pz = nullptr) {
   const auto &nodes = tree.nodes;
   const auto &xs = tree.xs, &ys = tree.ys, &zs = tree.zs;
   const std::size_t size = ops.size();
@@ -85,9 +88,13 @@ inline void upward_pass(const Tree &tree, const double *q, Operators &ops, std::
   for (std::size_t i = nodes.size(); i-- > 0;) {
     const Node &A = nodes[i];
     double *Mi = multipole.data() + i * size;
-    if (A.leaf() && !(given && (*given)[i]))
+    if (A.leaf() && !(given && (*given)[i])) {
       ops.p2m_batch(A.count(), xs.data() + A.begin, ys.data() + A.begin, zs.data() + A.begin, q + A.begin, A.center,
                     Mi);
+      if (px)
+        ops.p2m_dipoles(A.count(), xs.data() + A.begin, ys.data() + A.begin, zs.data() + A.begin, px + A.begin,
+                        py + A.begin, pz + A.begin, A.center, Mi);
+    }
     ops.symmetrize(Mi);
     if (A.parent >= 0) ops.m2m(Mi, A.center - nodes[A.parent].center, multipole.data() + A.parent * size);
   }
@@ -227,6 +234,8 @@ struct SolverCore {
   // charges and results in the tree's (sorted) particle order
   std::vector<double> sorted_q, sorted_pot, sorted_ex, sorted_ey, sorted_ez;
   std::vector<double> sorted_average_pot;     // the average far field's part of sorted_pot
+  // evaluate_dipoles(): dipoles (units of h) and field gradients (6 per particle), tree order
+  std::vector<double> sorted_px, sorted_py, sorted_pz, sorted_g;
   bool evaluated = false;                     // evaluate() ran since the last build()
   detail::TargetRange last_range;                     // targets of the last evaluate()
   std::vector<const double *> batch_m;        // M2L batch of one target node: source multipoles
@@ -243,7 +252,8 @@ struct SolverCore {
   std::size_t memory_bytes() const {
     std::size_t b = tree_bytes(tree) + lists_bytes(lists) + far.memory_bytes();
     for (const auto *v : {&scaled_x, &scaled_y, &scaled_z, &multipole, &local, &sorted_q, &sorted_pot, &sorted_ex,
-                          &sorted_ey, &sorted_ez, &sorted_average_pot, &leaf_prefix})
+                          &sorted_ey, &sorted_ez, &sorted_average_pot, &leaf_prefix, &sorted_px, &sorted_py,
+                          &sorted_pz, &sorted_g})
       b += vector_bytes(*v);
     b += vector_bytes(has_local) + vector_bytes(batch_m) + vector_bytes(batch_r) + vector_bytes(coincident);
     return b + (ops ? ops->size() * sizeof(double) * 3 * Operators::kBatch : 0);
@@ -308,6 +318,15 @@ struct SolverCore {
   void add_average_far_field(double qsum, double blo, double bhi, const detail::TargetRange &t);
   // the results of the targets t in the caller's order, back from the length unit h
   void scatter(const detail::TargetRange &t, double *pot, double *ex, double *ey, double *ez) const;
+  // ---- evaluate_dipoles() phases (solver_dipoles.cpp) ----
+  // charges and dipoles to tree order (zero where not given); true if any dipole is nonzero
+  bool sort_dipoles(const DipoleSources &src);
+  // the first coincident pair with a charge or a dipole, as input indices i < j; false if none
+  bool source_coincident_pair(std::size_t &i, std::size_t &j) const;
+  void p2p_dipoles(const detail::TargetRange &t, bool gradient);
+  void downward_gradient(const detail::TargetRange &t, bool gradient);
+  void far_field_dipoles(const detail::TargetRange &t, bool gradient);
+  void scatter_dipoles(const detail::TargetRange &t, const FieldOutputs &out) const;
   // energy_potential() of the last evaluate() (solver.hpp)
   void energy_potential(double *u) const;
 };

@@ -36,16 +36,25 @@ struct PointField {
   SymTensor g;
 };
 
+/** @brief Add the potential and field (not the gradient) of a charge q at a target displaced by
+ *  d = target - source (d != 0); returns 1 / r^2 for add_charge(). */
+inline double add_charge_field(double q, const Vec3 &d, double &pot, Vec3 &e)
+{
+  const double r2 = norm2(d), rinv = 1.0 / std::sqrt(r2), rinv2 = rinv * rinv;
+  const double q3 = q * rinv * rinv2;
+  pot += q * rinv;
+  e.x += q3 * d.x;
+  e.y += q3 * d.y;
+  e.z += q3 * d.z;
+  return rinv2;
+}
+
 /** @brief Add the potential, field and field gradient of a charge q at a target displaced by
  *  d = target - source (d != 0). */
 inline void add_charge(double q, const Vec3 &d, PointField &f)
 {
-  const double r2 = norm2(d), rinv = 1.0 / std::sqrt(r2), rinv2 = rinv * rinv;
-  const double q3 = q * rinv * rinv2, q5 = 3.0 * q3 * rinv2;
-  f.pot += q * rinv;
-  f.e.x += q3 * d.x;
-  f.e.y += q3 * d.y;
-  f.e.z += q3 * d.z;
+  const double rinv2 = add_charge_field(q, d, f.pot, f.e);
+  const double q3 = q * rinv2 * std::sqrt(rinv2), q5 = 3.0 * q3 * rinv2;
   f.g.xx += q3 - q5 * d.x * d.x;
   f.g.yy += q3 - q5 * d.y * d.y;
   f.g.zz += q3 - q5 * d.z * d.z;
@@ -54,18 +63,28 @@ inline void add_charge(double q, const Vec3 &d, PointField &f)
   f.g.yz -= q5 * d.y * d.z;
 }
 
+/** @brief Add the potential and field (not the gradient) of a point dipole p at a target
+ *  displaced by d = target - source (d != 0); returns 1 / r^2 for add_dipole(). */
+inline double add_dipole_field(const Vec3 &p, const Vec3 &d, double &pot, Vec3 &e)
+{
+  const double r2 = norm2(d), rinv = 1.0 / std::sqrt(r2), rinv2 = rinv * rinv;
+  const double r3 = rinv * rinv2, r5 = r3 * rinv2;
+  const double pd = dot(p, d);
+  pot += pd * r3;
+  const double a = 3.0 * pd * r5;
+  e.x += a * d.x - p.x * r3;
+  e.y += a * d.y - p.y * r3;
+  e.z += a * d.z - p.z * r3;
+  return rinv2;
+}
+
 /** @brief Add the potential, field and field gradient of a point dipole p at a target
  *  displaced by d = target - source (d != 0). */
 inline void add_dipole(const Vec3 &p, const Vec3 &d, PointField &f)
 {
-  const double r2 = norm2(d), rinv = 1.0 / std::sqrt(r2), rinv2 = rinv * rinv;
-  const double r3 = rinv * rinv2, r5 = r3 * rinv2, r7 = r5 * rinv2;
+  const double rinv2 = add_dipole_field(p, d, f.pot, f.e);
+  const double r5 = rinv2 * rinv2 * std::sqrt(rinv2), r7 = r5 * rinv2;
   const double pd = dot(p, d);
-  f.pot += pd * r3;
-  const double a = 3.0 * pd * r5;
-  f.e.x += a * d.x - p.x * r3;
-  f.e.y += a * d.y - p.y * r3;
-  f.e.z += a * d.z - p.z * r3;
   const double b = 3.0 * r5, c = 15.0 * pd * r7;
   f.g.xx += b * (2.0 * p.x * d.x + pd) - c * d.x * d.x;
   f.g.yy += b * (2.0 * p.y * d.y + pd) - c * d.y * d.y;

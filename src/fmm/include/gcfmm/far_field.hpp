@@ -127,6 +127,19 @@ class PeriodicFarField {
                 double *ez, int part = 0, int nparts = 1, const PartSum &sum = nullptr) const;
 
   /**
+   * @brief evaluate() with point dipoles among the sources and, optionally, the field gradient
+   * at the targets (doc/polarization.md, section 5.3): a dipole p at y is anterpolated as
+   * p . grad_y of the interpolation weights (the limit of two opposite charges), and the
+   * gradient G_ab = dE_a/dx_b is the interpolant's second derivative. q, px, py, pz may each
+   * be null (none); g6 (6 per particle: xx, xy, xz, yy, yz, zz, indexed like ex) may be null.
+   * Every caller anterpolates all sources (no PartSum).
+   * @throws as evaluate().
+   */
+  void evaluate_dipoles(std::size_t n, const double *x, const double *y, const double *z, const double *q,
+                        const double *px, const double *py, const double *pz, std::size_t begin, std::size_t end,
+                        double *pot, double *ex, double *ey, double *ez, double *g6) const;
+
+  /**
    * @brief The source half of evaluate(), for a source set that stays fixed while the targets
    * move (StaticSourceField): the node potentials Phi_t of every box t of the column
    * (doc/theory.md, eq. (4.6): anterpolation W_b, then Phi_t = sum_b K_{t-b} W_b), the same
@@ -172,7 +185,8 @@ class PeriodicFarField {
                       int images, int pxy, int pz, double hz_max);
 
  private:
-  static void interp_weights(double t, int p, const double *tab, double *s, double *ds);
+  // Lagrange weights s, their derivatives ds and (if d2s is not null) second derivatives d2s
+  static void interp_weights(double t, int p, const double *tab, double *s, double *ds, double *d2s = nullptr);
   // node charges -> node potentials, (p^2 pz) x nb, from the source boxes [src_lo, src_hi) at
   // the target boxes [tgt_lo, tgt_hi) only (the other columns of phi are zero)
   void apply(const double *w, double *phi, int src_lo, int src_hi, int tgt_lo, int tgt_hi) const;
@@ -180,6 +194,9 @@ class PeriodicFarField {
   // spans holding any particle (tgt) and any nonzero charge (src); [lo, hi) = [nb, 0) if none
   void anterpolate(std::size_t n, const double *x, const double *y, const double *z, const double *q, int a0,
                    int a1, std::vector<double> &w, int *src_lo, int *src_hi, int *tgt_lo, int *tgt_hi) const;
+  // interpolate() with the field gradient g6 (6 per particle) too
+  void interpolate_gradient(const double *phi, const double *x, const double *y, const double *z, std::size_t begin,
+                            std::size_t end, double *pot, double *ex, double *ey, double *ez, double *g6) const;
   int locate(std::size_t i, double x, double y, double z, double *tx, double *ty, double *tz) const;
   void interpolate(const double *phi, const double *x, const double *y, const double *z,
                    std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,

@@ -27,6 +27,16 @@ void p2p_with(SimdPath path, std::size_t nt, const double *xt, const double *yt,
               const double *xs, const double *ys, const double *zs, const double *qs, double sx, double sy, double sz,
               double *pot, double *ex, double *ey, double *ez, double r2_min = 0.0);
 
+/** @brief P2P of charges and point dipoles (doc/polarization.md, eq. (1.1)-(1.2)): add the
+ *  potential, field and, if g6 is not null, the field gradient (6 per target: xx, xy, xz, yy,
+ *  yz, zz) of sources (xs, ys, zs) with charges qs and dipoles (pxs, pys, pzs), shifted by
+ *  (sx, sy, sz), at targets (xt, yt, zt)[0..nt). Pairs with |r_i - r_j - s|^2 <= r2_min are
+ *  skipped, as in p2p(). Scalar: the terms are those of dipole_kernels.hpp. */
+void p2p_dipoles(std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
+                 const double *xs, const double *ys, const double *zs, const double *qs, const double *pxs,
+                 const double *pys, const double *pzs, double sx, double sy, double sz, double *pot, double *ex,
+                 double *ey, double *ez, double *g6, double r2_min = 0.0);
+
 /** @brief O(N^2) free-space reference: pot_i = sum_{j != i} q_j / r_ij and E_i = -grad pot_i
  *  (outputs are overwritten). Coincident pairs are skipped. */
 void direct_free(std::size_t n, const double *x, const double *y, const double *z, const double *q,

@@ -57,6 +57,23 @@ class CoincidentParticles : public std::runtime_error {
  *  asked for, while the field q / d^2 is 1e20 times a typical one. */
 inline constexpr double kCoincidenceRadius = 1e-10;
 
+//! Sources of Solver::evaluate_dipoles: arrays over the particles of build(), caller's order.
+struct DipoleSources {
+  const double *q = nullptr;   //!< charges; null: none
+  const double *px = nullptr;  //!< point dipoles (charge x length); null (all three): none
+  const double *py = nullptr;
+  const double *pz = nullptr;
+};
+
+//! Outputs of Solver::evaluate_dipoles (overwritten), caller's order.
+struct FieldOutputs {
+  double *pot = nullptr;       //!< potential
+  double *ex = nullptr;        //!< field E = -grad pot
+  double *ey = nullptr;
+  double *ez = nullptr;
+  double *gradient = nullptr;  //!< 6 per particle, G_ab = dE_a/dx_b as xx, xy, xz, yy, yz, zz; null: not computed
+};
+
 /** Adaptive FMM solver. Usage: Solver s(opts); s.set_box(...) (periodic); s.build(n, x, y, z);
  *  s.evaluate(q, pot, ex, ey, ez) (any number of times with new charges); s.stats(). */
 class Solver {
@@ -98,6 +115,17 @@ class Solver {
    *  or meaningless); std::runtime_error if build() was not called. */
   void evaluate(const double *q, double *pot, double *ex, double *ey, double *ez, int part = 0, int nparts = 1,
                 const PartSum &sum = nullptr);
+
+  /** @brief evaluate() with point dipoles among the sources (doc/polarization.md, section 5):
+   *  the potential pot_i = sum_j [q_j / r_ij + p_j . r_ij / r_ij^3] (r_ij = r_i - r_j), the
+   *  field and, if out.gradient is set, the field gradient at every particle, over the same
+   *  images and far field as evaluate(). The self term is dropped. The dipoles enter the
+   *  upward pass by their P2M (eq. (5.1)) and the near field by dipole_kernels.hpp; the
+   *  gradient comes from the local expansions to second degree (eq. (5.2)) and the far
+   *  field's second derivative. Work partitions as in evaluate() (no PartSum).
+   *  @throws std::invalid_argument with FarField::Average (its smeared images are of charges
+   *  only); CoincidentParticles if two sources coincide; as evaluate() otherwise. */
+  void evaluate_dipoles(const DipoleSources &src, const FieldOutputs &out, int part = 0, int nparts = 1);
 
   /** @brief Per-particle potential u of the energy of the last evaluate(): the energy
    *  U = 1/2 sum_i q_i u_i is the one whose gradient is minus the applied forces q_i E_i
