@@ -97,8 +97,7 @@ PolarizableResult solve_polarizable_direct(const PolarizableSystem &s,
     res.field[i] = f;
     res.force[i] = point_force(s.q[i], pi, f);
     const Vec3 e0i{e0[3 * i], e0[3 * i + 1], e0[3 * i + 2]};
-    res.energy += 0.5 * s.q[i] * f0[i].pot - s.q[i] * dot(s.applied_field, ri - origin) -
-                  0.5 * dot(pi, e0i);
+    res.energy += polarizable_energy_term(s.q[i], f0[i].pot, s.applied_field, ri - origin, pi, e0i);
   }
   return res;
 }

@@ -1,0 +1,79 @@
+// GRANULAR-CHARGED FMM core library (gcfmm).
+// Charged, polarizable particles by the FMM: a uniform applied field, induced point dipoles
+// solved self-consistently (mutual induction, warm-started), a grounded electrode by image
+// sources in the same tree, forces q E + G p and the energy of doc/polarization.md, eq. (3.4).
+// The FMM counterpart of direct_polarizable.hpp (its reference), over Solver::evaluate_dipoles.
+#ifndef GCFMM_POLARIZABLE_SOLVER_HPP
+#define GCFMM_POLARIZABLE_SOLVER_HPP
+
+#include <cstddef>
+#include <vector>
+
+#include "gcfmm/options.hpp"
+#include "gcfmm/polarization.hpp"
+#include "gcfmm/solver.hpp"
+#include "gcfmm/types.hpp"
+
+namespace gcfmm {
+
+//! What surrounds the particles (bare units).
+struct PolarizableEnvironment {
+  Vec3 applied_field;         //!< uniform applied field
+  bool electrode = false;     //!< a grounded conducting plane z = electrode_z below every particle
+  double electrode_z = 0.0;
+};
+
+//! Per-particle results of PolarizableSolver::compute (caller's order; 3 per particle for vectors).
+struct PolarizableOutputs {
+  std::vector<double> field;   //!< total field E at each particle (applied field included), 3 n
+  std::vector<double> force;   //!< q E + G p, 3 n
+  std::vector<double> energy;  //!< per-particle terms of eq. (3.4) (they sum to the energy), n
+};
+
+/** Usage: PolarizableSolver s(opts); s.set_box(...) (periodic); s.set_environment(env);
+ *  s.compute(n, x, y, z, q, alpha, p, out) once per step, p holding the last step's dipoles.
+ *  With an electrode the tree holds the particles and their mirror images (2 n sources),
+ *  images of charges -q and of dipoles (-px, -py, pz) (dipole_kernels.hpp). */
+class PolarizableSolver {
+ public:
+  explicit PolarizableSolver(const Options &opts);
+  /** @brief Periodic2D: the primary cell (Solver::set_box). */
+  void set_box(double xlo, double ylo, double lx, double ly);
+  /** @brief Periodic2D with FarField::Exact: the z range the far field covers (Solver::
+   *  set_z_range); with an electrode the mirror of the range is added. */
+  void set_z_range(double zlo, double zhi);
+  /** @throws std::invalid_argument if a component of the field or electrode_z is not finite. */
+  void set_environment(const PolarizableEnvironment &env);
+  /** @brief The induction's stopping rule (default: residual 0.1 x Options::accuracy). */
+  void set_induction(const PolarizationSettings &settings);
+
+  /** @brief Dipoles, fields, forces and energy of n particles with charges q and
+   *  polarizabilities alpha (null: none, p = 0). p (3 n): in, the starting dipoles (warm
+   *  start); out, the solution.
+   *  @throws std::invalid_argument if a particle is at or below the electrode, or as
+   *  solve_induced_dipoles(); CoincidentParticles as Solver::evaluate_dipoles. */
+  void compute(std::size_t n, const double *x, const double *y, const double *z, const double *q,
+               const double *alpha, double *p, PolarizableOutputs &out);
+
+  const PolarizationReport &report() const { return report_; }  //!< the last induction solve
+  double energy() const { return energy_; }                      //!< total energy of the last compute()
+  const Stats &stats() const { return solver_.stats(); }        //!< the FMM's last evaluation
+  const Options &options() const { return solver_.options(); }
+
+ private:
+  // field at the n particles of the sources q (2 n with images) and dipoles p (3 n, or null),
+  // into pot, ex, ey, ez (2 n each) and g (6 x 2 n, or none)
+  void evaluate(const double *p, bool charges, bool gradient);
+  Solver solver_;
+  PolarizableEnvironment env_;
+  PolarizationSettings induction_;
+  PolarizationReport report_;
+  double energy_ = 0.0;
+  std::size_t n_ = 0;
+  std::vector<double> sx_, sy_, sz_, sq_, spx_, spy_, spz_;  // sources (particles, then images)
+  std::vector<double> pot_, ex_, ey_, ez_, g_;                // results at the sources
+};
+
+}  // namespace gcfmm
+
+#endif

@@ -1,0 +1,142 @@
+// GRANULAR-CHARGED FMM core library (gcfmm): charged, polarizable particles by the FMM
+// (polarizable_solver.hpp; doc/polarization.md, section 5).
+#include "gcfmm/polarizable_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "gcfmm/dipole_kernels.hpp"
+
+namespace gcfmm {
+
+PolarizableSolver::PolarizableSolver(const Options &opts) : solver_(opts) {
+  induction_.tolerance = 0.1 * solver_.options().accuracy;
+}
+
+void PolarizableSolver::set_box(double xlo, double ylo, double lx, double ly) { solver_.set_box(xlo, ylo, lx, ly); }
+
+void PolarizableSolver::set_z_range(double zlo, double zhi) {
+  if (env_.electrode) zlo = std::min(zlo, 2.0 * env_.electrode_z - zhi);
+  solver_.set_z_range(zlo, zhi);
+}
+
+void PolarizableSolver::set_environment(const PolarizableEnvironment &env) {
+  const Vec3 &e = env.applied_field;
+  if (!std::isfinite(e.x) || !std::isfinite(e.y) || !std::isfinite(e.z) || !std::isfinite(env.electrode_z))
+    throw std::invalid_argument("gcfmm: the applied field and the electrode position must be finite");
+  env_ = env;
+}
+
+void PolarizableSolver::set_induction(const PolarizationSettings &settings) {
+  if (!(settings.tolerance > 0.0) || settings.max_iterations < 1)
+    throw std::invalid_argument("gcfmm: the induction needs a tolerance > 0 and max_iterations >= 1");
+  induction_ = settings;
+}
+
+void PolarizableSolver::evaluate(const double *p, bool charges, bool gradient) {
+  const std::size_t ns = sx_.size();
+  if (p) {
+    for (std::size_t i = 0; i < n_; ++i) {
+      spx_[i] = p[3 * i];
+      spy_[i] = p[3 * i + 1];
+      spz_[i] = p[3 * i + 2];
+      if (ns > n_) {
+        const Vec3 img = image_dipole({spx_[i], spy_[i], spz_[i]});
+        spx_[n_ + i] = img.x;
+        spy_[n_ + i] = img.y;
+        spz_[n_ + i] = img.z;
+      }
+    }
+  }
+  DipoleSources src;
+  if (charges) src.q = sq_.data();
+  if (p) {
+    src.px = spx_.data();
+    src.py = spy_.data();
+    src.pz = spz_.data();
+  }
+  g_.resize(gradient ? 6 * ns : 0);
+  solver_.evaluate_dipoles(src, {pot_.data(), ex_.data(), ey_.data(), ez_.data(), gradient ? g_.data() : nullptr});
+}
+
+void PolarizableSolver::compute(std::size_t n, const double *x, const double *y, const double *z, const double *q,
+                                const double *alpha, double *p, PolarizableOutputs &out) {
+  if (env_.electrode)
+    for (std::size_t i = 0; i < n; ++i)
+      if (!(z[i] > env_.electrode_z))
+        throw std::invalid_argument("gcfmm: particle " + std::to_string(i) + " is not above the electrode (z = " +
+                                    std::to_string(z[i]) + " <= " + std::to_string(env_.electrode_z) + ")");
+  n_ = n;
+  const std::size_t ns = env_.electrode ? 2 * n : n;
+  for (auto *v : {&sx_, &sy_, &sz_, &sq_, &spx_, &spy_, &spz_, &pot_, &ex_, &ey_, &ez_}) v->assign(ns, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    sx_[i] = x[i];
+    sy_[i] = y[i];
+    sz_[i] = z[i];
+    sq_[i] = q[i];
+    if (ns > n) {
+      const Vec3 m = mirror_point({x[i], y[i], z[i]}, env_.electrode_z);
+      sx_[n + i] = m.x;
+      sy_[n + i] = m.y;
+      sz_[n + i] = m.z;
+      sq_[n + i] = image_charge(q[i]);
+    }
+  }
+  solver_.build(ns, sx_.data(), sy_.data(), sz_.data());
+
+  // E0: the charges (and their images) and the applied field
+  evaluate(nullptr, true, false);
+  const Vec3 &ea = env_.applied_field;
+  std::vector<double> e0(3 * n), phi_q(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    e0[3 * i] = ex_[i] + ea.x;
+    e0[3 * i + 1] = ey_[i] + ea.y;
+    e0[3 * i + 2] = ez_[i] + ea.z;
+    phi_q[i] = pot_[i];
+  }
+  report_ = PolarizationReport{};
+  if (alpha) {
+    const DipoleFieldOperator field = [&](const double *pv, double *f) {
+      evaluate(pv, false, false);
+      for (std::size_t i = 0; i < n; ++i) {
+        f[3 * i] = ex_[i];
+        f[3 * i + 1] = ey_[i];
+        f[3 * i + 2] = ez_[i];
+      }
+    };
+    report_ = solve_induced_dipoles(n, alpha, e0.data(), field, p, induction_);
+  } else {
+    for (std::size_t k = 0; k < 3 * n; ++k) p[k] = 0.0;
+    report_.converged = true;
+  }
+
+  // the total field and its gradient with the converged dipoles
+  evaluate(alpha ? p : nullptr, true, true);
+  out.field.assign(3 * n, 0.0);
+  out.force.assign(3 * n, 0.0);
+  out.energy.assign(n, 0.0);
+  energy_ = 0.0;
+  const Vec3 origin{0.0, 0.0, env_.electrode ? env_.electrode_z : 0.0};
+  for (std::size_t i = 0; i < n; ++i) {
+    PointField f;
+    f.e = Vec3{ex_[i], ey_[i], ez_[i]} + ea;
+    const double *g = g_.data() + 6 * i;
+    f.g = SymTensor{g[0], g[1], g[2], g[3], g[4], g[5]};
+    const Vec3 pi{p[3 * i], p[3 * i + 1], p[3 * i + 2]};
+    const Vec3 force = point_force(q[i], pi, f);
+    double *fi = out.field.data() + 3 * i, *Fi = out.force.data() + 3 * i;
+    fi[0] = f.e.x;
+    fi[1] = f.e.y;
+    fi[2] = f.e.z;
+    Fi[0] = force.x;
+    Fi[1] = force.y;
+    Fi[2] = force.z;
+    const Vec3 e0i{e0[3 * i], e0[3 * i + 1], e0[3 * i + 2]};
+    out.energy[i] = polarizable_energy_term(q[i], phi_q[i], ea, Vec3{x[i], y[i], z[i]} - origin, pi, e0i);
+    energy_ += out.energy[i];
+  }
+}
+
+}  // namespace gcfmm
