@@ -227,40 +227,119 @@ void direct_images(std::size_t n, const double *x, const double *y, const double
       p2p(n, x, y, z, n, x, y, z, q, nx * lx, ny * ly, 0.0, pot, ex, ey, ez);
 }
 
+namespace {
+
+// Sources [0, ns) at targets [0, nt): the terms of dipole_kernels.hpp, vectorised over the
+// sources (omp simd), only those the sources carry. A pair at or inside r2_min (the self term,
+// coincident pairs) is given a harmless displacement and zero weight: the loop has no branch.
+template <bool kCharges, bool kDipoles, bool kGradient>
+GCFMM_ALWAYS_INLINE void p2p_dipoles_loop(std::size_t nt, const double *xt, const double *yt, const double *zt,
+                                          std::size_t ns, const double *__restrict xs, const double *__restrict ys,
+                                          const double *__restrict zs, const double *__restrict qs,
+                                          const double *__restrict pxs, const double *__restrict pys,
+                                          const double *__restrict pzs, double sx, double sy, double sz,
+                                          double *pot, double *ex, double *ey, double *ez, double *g6,
+                                          double r2_min) {
+  for (std::size_t i = 0; i < nt; ++i) {
+    const double tx = xt[i] - sx, ty = yt[i] - sy, tz = zt[i] - sz;
+    double ap = 0, ax = 0, ay = 0, az = 0, gxx = 0, gxy = 0, gxz = 0, gyy = 0, gyz = 0, gzz = 0;
+#pragma omp simd reduction(+ : ap, ax, ay, az, gxx, gxy, gxz, gyy, gyz, gzz)
+    for (std::size_t j = 0; j < ns; ++j) {
+      Vec3 d{tx - xs[j], ty - ys[j], tz - zs[j]};
+      const bool skip = norm2(d) <= r2_min;
+      const double w = skip ? 0.0 : 1.0;
+      if (skip) d = Vec3{1.0, 0.0, 0.0};
+      PointField f;
+      if (kCharges) {
+        if (kGradient)
+          add_charge(w * qs[j], d, f);
+        else
+          add_charge_field(w * qs[j], d, f.pot, f.e);
+      }
+      if (kDipoles) {
+        const Vec3 p{w * pxs[j], w * pys[j], w * pzs[j]};
+        if (kGradient)
+          add_dipole(p, d, f);
+        else
+          add_dipole_field(p, d, f.pot, f.e);
+      }
+      ap += f.pot;
+      ax += f.e.x;
+      ay += f.e.y;
+      az += f.e.z;
+      if (kGradient) {
+        gxx += f.g.xx;
+        gxy += f.g.xy;
+        gxz += f.g.xz;
+        gyy += f.g.yy;
+        gyz += f.g.yz;
+        gzz += f.g.zz;
+      }
+    }
+    pot[i] += ap;
+    ex[i] += ax;
+    ey[i] += ay;
+    ez[i] += az;
+    if (kGradient) {
+      double *g = g6 + 6 * i;
+      g[0] += gxx;
+      g[1] += gxy;
+      g[2] += gxz;
+      g[3] += gyy;
+      g[4] += gyz;
+      g[5] += gzz;
+    }
+  }
+}
+
+// the instance of what the sources carry (charges, dipoles) and whether the gradient is asked
+GCFMM_ALWAYS_INLINE void p2p_dipoles_body(std::size_t nt, const double *xt, const double *yt, const double *zt,
+                                          std::size_t ns, const double *xs, const double *ys, const double *zs,
+                                          const double *qs, const double *pxs, const double *pys,
+                                          const double *pzs, double sx, double sy, double sz, double *pot,
+                                          double *ex, double *ey, double *ez, double *g6, double r2_min,
+                                          bool charges, bool dipoles) {
+#define GCFMM_P2P_DIPOLES(C, D, G) \
+  p2p_dipoles_loop<C, D, G>(nt, xt, yt, zt, ns, xs, ys, zs, qs, pxs, pys, pzs, sx, sy, sz, pot, ex, ey, ez, g6, r2_min)
+  if (g6) {
+    if (charges && dipoles) GCFMM_P2P_DIPOLES(true, true, true);
+    else if (charges) GCFMM_P2P_DIPOLES(true, false, true);
+    else if (dipoles) GCFMM_P2P_DIPOLES(false, true, true);
+  } else {
+    if (charges && dipoles) GCFMM_P2P_DIPOLES(true, true, false);
+    else if (charges) GCFMM_P2P_DIPOLES(true, false, false);
+    else if (dipoles) GCFMM_P2P_DIPOLES(false, true, false);
+  }
+#undef GCFMM_P2P_DIPOLES
+}
+
+GCFMM_DEFINE_SIMD_PATHS(void, p2p_dipoles_path,
+                        (std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
+                         const double *xs, const double *ys, const double *zs, const double *qs, const double *pxs,
+                         const double *pys, const double *pzs, double sx, double sy, double sz, double *pot,
+                         double *ex, double *ey, double *ez, double *g6, double r2_min, bool charges, bool dipoles),
+                        p2p_dipoles_body,
+                        (nt, xt, yt, zt, ns, xs, ys, zs, qs, pxs, pys, pzs, sx, sy, sz, pot, ex, ey, ez, g6, r2_min,
+                         charges, dipoles))
+
+}  // namespace
+
 void p2p_dipoles(std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
                  const double *xs, const double *ys, const double *zs, const double *qs, const double *pxs,
                  const double *pys, const double *pzs, double sx, double sy, double sz, double *pot, double *ex,
                  double *ey, double *ez, double *g6, double r2_min) {
-  for (std::size_t i = 0; i < nt; ++i) {
-    const Vec3 ti{xt[i] - sx, yt[i] - sy, zt[i] - sz};
-    PointField f;
-    for (std::size_t j = 0; j < ns; ++j) {
-      const Vec3 d{ti.x - xs[j], ti.y - ys[j], ti.z - zs[j]};
-      if (norm2(d) <= r2_min) continue;
-      const Vec3 p{pxs[j], pys[j], pzs[j]};
-      const bool dipole = p.x != 0.0 || p.y != 0.0 || p.z != 0.0;
-      if (g6) {
-        if (qs[j] != 0.0) add_charge(qs[j], d, f);
-        if (dipole) add_dipole(p, d, f);
-      } else {
-        if (qs[j] != 0.0) add_charge_field(qs[j], d, f.pot, f.e);
-        if (dipole) add_dipole_field(p, d, f.pot, f.e);
-      }
-    }
-    pot[i] += f.pot;
-    ex[i] += f.e.x;
-    ey[i] += f.e.y;
-    ez[i] += f.e.z;
-    if (g6) {
-      double *g = g6 + 6 * i;
-      g[0] += f.g.xx;
-      g[1] += f.g.xy;
-      g[2] += f.g.xz;
-      g[3] += f.g.yy;
-      g[4] += f.g.yz;
-      g[5] += f.g.zz;
-    }
+  // what this source range carries: a range without dipoles (or charges) skips their terms
+  bool charges = false, dipoles = false;
+  for (std::size_t j = 0; j < ns; ++j) {
+    charges = charges || qs[j] != 0.0;
+    dipoles = dipoles || pxs[j] != 0.0 || pys[j] != 0.0 || pzs[j] != 0.0;
   }
+  if (!dipoles && !g6) {  // charges only: the P2P of evaluate()
+    p2p(nt, xt, yt, zt, ns, xs, ys, zs, qs, sx, sy, sz, pot, ex, ey, ez, r2_min);
+    return;
+  }
+  p2p_dipoles_path_for(default_simd_path())(nt, xt, yt, zt, ns, xs, ys, zs, qs, pxs, pys, pzs, sx, sy, sz, pot, ex,
+                                            ey, ez, g6, r2_min, charges, dipoles);
 }
 
 }  // namespace gcfmm

@@ -31,7 +31,7 @@ void p2p_with(SimdPath path, std::size_t nt, const double *xt, const double *yt,
  *  potential, field and, if g6 is not null, the field gradient (6 per target: xx, xy, xz, yy,
  *  yz, zz) of sources (xs, ys, zs) with charges qs and dipoles (pxs, pys, pzs), shifted by
  *  (sx, sy, sz), at targets (xt, yt, zt)[0..nt). Pairs with |r_i - r_j - s|^2 <= r2_min are
- *  skipped, as in p2p(). Scalar: the terms are those of dipole_kernels.hpp. */
+ *  skipped, as in p2p(). The terms are those of dipole_kernels.hpp (vectorised over the sources). */
 void p2p_dipoles(std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
                  const double *xs, const double *ys, const double *zs, const double *qs, const double *pxs,
                  const double *pys, const double *pzs, double sx, double sy, double sz, double *pot, double *ex,
