@@ -12,6 +12,7 @@
 #include "coul_fmm_comm.h"
 #include "coul_fmm_evaluator.h"
 #include "coul_fmm_near.h"
+#include "coul_fmm_polarizable.h"
 #include "fix_sleep_gran.h"
 
 #include "atom.h"
@@ -42,12 +43,12 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), opts(new gcfmm::Options), mpi(new CoulFMMComm(lmp)),
     near(new CoulFMMNearRefresh(lmp, this)), bed_given(false), sleepers_static(true),
     distributed(false), nevaluations(0), energy_local(0.0), energy_all(0.0), energy_summed(false),
-    ilevel_respa(0), field(nullptr), eval_state(nullptr)
+    ilevel_respa(0), field_cols(4), polar_force(nullptr), field(nullptr), eval_state(nullptr)
 {
   scalar_flag = 1;
   extscalar = 1;
   vector_flag = 1;    // diagnostics: solver (error estimate, order, M2L, P2P), MTS check, schedule
-  size_vector = 12;
+  size_vector = 14;
   extvector = 0;
   global_freq = 1;
   energy_global_flag = 1;
@@ -63,6 +64,7 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
   comm_forward = MTS::DELTA_COLS;    // displacements since the evaluations, for the near refresh
 
   parse_keywords(narg, arg);
+  size_peratom_cols = field_cols;
   evaluator = std::make_unique<CoulFMMEvaluator>(lmp, id, groupbit);
   FixCoulFMM::grow_arrays(atom->nmax);
   atom->add_callback(Atom::GROW);
@@ -83,13 +85,18 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
                                                  {"images", &opts->images},
                                                  {"every", &mts.every},
                                                  {"check", &mts.check_every}};
-  for (int iarg = 3; iarg < narg; iarg += 2) {
+  CoulFMMPolarizable::Settings polar;
+  bool any_polar = false;
+  for (int iarg = 3; iarg < narg;) {
     const std::string key = arg[iarg];
     const bool known = reals.count(key) || integers.count(key) || key == "farfield" ||
-        key == "bed" || key == "extrapolate" || key == "sleepers" || key == "solver";
+        key == "bed" || key == "extrapolate" || key == "sleepers" || key == "solver" ||
+        key == "efield" || key == "polarize" || key == "electrode" || key == "induction";
     if (!known) error->all(FLERR, iarg, "Unknown fix coul/fmm keyword: {}", key);
-    if (iarg + (key == "bed" ? 2 : 1) >= narg)
-      utils::missing_cmd_args(FLERR, "fix coul/fmm " + key, error);
+    // values of the keyword: polarize takes eps_p and an optional eps_m
+    int nvals = key == "bed" ? 2 : (key == "efield" ? 3 : 1);
+    if (key == "polarize" && iarg + 2 < narg && utils::is_double(arg[iarg + 2])) nvals = 2;
+    if (iarg + nvals >= narg) utils::missing_cmd_args(FLERR, "fix coul/fmm " + key, error);
     const std::string v = arg[iarg + 1];
     if (reals.count(key)) {
       *reals.at(key) = utils::numeric(FLERR, v, false, lmp);
@@ -109,9 +116,33 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
       opts->bed_zlo = utils::numeric(FLERR, v, false, lmp);
       opts->bed_zhi = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
       bed_given = true;
-      iarg++;
+    } else if (key == "efield") {
+      polar.efield = true;
+      for (int a = 0; a < 3; a++) polar.field[a] = utils::numeric(FLERR, arg[iarg + 1 + a], false, lmp);
+    } else if (key == "polarize") {
+      polar.polarize = true;
+      polar.eps_particle = utils::numeric(FLERR, v, false, lmp);
+      if (nvals == 2) polar.eps_medium = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
+      if (!(polar.eps_particle > 0.0) || (nvals == 2 && !(polar.eps_medium > 0.0)))
+        error->all(FLERR, iarg, "Fix coul/fmm polarize: permittivities must be > 0, got {}{}", v,
+                   nvals == 2 ? std::string(" ") + arg[iarg + 2] : std::string());
+    } else if (key == "electrode") {
+      polar.electrode = true;
+      polar.electrode_z = utils::numeric(FLERR, v, false, lmp);
+    } else if (key == "induction") {
+      polar.tolerance = utils::numeric(FLERR, v, false, lmp);
+      if (!(polar.tolerance > 0.0 && polar.tolerance < 1.0))
+        error->all(FLERR, iarg, "Fix coul/fmm induction must be in (0, 1), got {}", v);
     }
     if (key == "images" || key == "farfield") periodic_keyword = key;
+    if (key == "efield" || key == "polarize" || key == "electrode") any_polar = true;
+    iarg += 1 + nvals;
+  }
+  if (any_polar) {
+    polarizable = std::make_unique<CoulFMMPolarizable>(lmp, polar, groupbit);
+    if (polar.polarize) field_cols = 7;
+  } else if (polar.tolerance > 0.0) {
+    error->all(FLERR, "Fix coul/fmm induction needs polarize");
   }
   // each value is checked once, by gcfmm::Options and CoulFMMTimeStepping::Settings
   try {
@@ -143,6 +174,7 @@ FixCoulFMM::~FixCoulFMM()
   atom->delete_callback(id, Atom::RESTART);
   memory->destroy(field);
   memory->destroy(eval_state);
+  memory->destroy(polar_force);
 }
 
 int FixCoulFMM::setmask()
@@ -164,6 +196,34 @@ void FixCoulFMM::init()
     if (respa_level >= 0) ilevel_respa = MIN(respa_level, ilevel_respa);
   }
   auto sleep = modify->get_fix_by_style("^sleep/gran$");
+  if (polarizable) {
+    // doc/fix_coul_fmm.md, "Applied field, induced dipoles, electrode": every step, replicated
+    if (distributed)
+      error->all(FLERR, "Fix coul/fmm efield, polarize and electrode need solver replicated");
+    if (!sleep.empty() && sleepers_static)
+      error->all(FLERR,
+                 "Fix coul/fmm efield, polarize and electrode need sleepers full with fix "
+                 "sleep/gran (the static sleepers' field has no dipoles or images)");
+    // LAMMPS's fix efield pushes the charges only: with efield here it would count the field
+    // twice, with polarize it would leave the dipoles blind to it
+    if (!modify->get_fix_by_style("^efield").empty()) {
+      if (polarizable->settings().efield)
+        error->all(FLERR,
+                   "Fix coul/fmm efield and fix efield would both apply the field: use one");
+      if (polarizable->settings().polarize)
+        error->all(FLERR,
+                   "Fix coul/fmm polarize with fix efield: fix efield's field would not "
+                   "polarize the particles; give it to fix coul/fmm efield instead");
+    }
+    const auto &mts = stepping->settings();
+    if ((mts.every > 1 || mts.near_cutoff > 0.0) && comm->me == 0)
+      error->warning(FLERR,
+                     "Fix coul/fmm {}: with efield, polarize or electrode every step is an "
+                     "evaluation (every, tolerance, near and extrapolate are ignored)",
+                     id);
+    polarizable->init(*opts);
+    return;
+  }
   evaluator->init(
       *opts, sleep.empty() || !sleepers_static ? nullptr : dynamic_cast<FixSleepGran *>(sleep[0]),
       thermo_virial, distributed);
@@ -220,7 +280,7 @@ void FixCoulFMM::setup(int vflag)
   // continue the schedule of the previous run (or of the restart file) when its stored field
   // still belongs to these atoms, charges and box: a run split into pieces, or continued from
   // a restart, then evaluates on the same steps as the uninterrupted run
-  if (!evaluator->continues(*stepping, eval_state)) stepping->restart_schedule();
+  if (!polarizable && !evaluator->continues(*stepping, eval_state)) stepping->restart_schedule();
   if (utils::strmatch(update->integrate_style, "^verlet")) {
     post_force(vflag);
   } else {
@@ -238,7 +298,7 @@ void FixCoulFMM::post_force_respa(int vflag, int ilevel, int /*iloop*/)
 
 void FixCoulFMM::min_setup(int vflag)
 {
-  if (stepping->settings().every > 1 && comm->me == 0)
+  if (!polarizable && stepping->settings().every > 1 && comm->me == 0)
     error->warning(FLERR,
                    "Fix coul/fmm {}: every {} is ignored during minimization (a minimizer "
                    "needs forces and energy of the current positions)",
@@ -249,6 +309,10 @@ void FixCoulFMM::min_setup(int vflag)
 // a line search evaluates several trial positions within one step: always recompute
 void FixCoulFMM::min_post_force(int vflag)
 {
+  if (polarizable) {
+    post_force_polarizable();
+    return;
+  }
   v_init(vflag);
   compute_field(false);
   apply_field();
@@ -258,6 +322,10 @@ void FixCoulFMM::min_post_force(int vflag)
 void FixCoulFMM::post_force(int vflag)
 {
   v_init(vflag);
+  if (polarizable) {
+    post_force_polarizable();
+    return;
+  }
   const bigint step = update->ntimestep;
   // evaluate on the schedule's steps, whenever atoms were added or removed (fix deposit,
   // evaporate: a new atom must feel, and exert, the force from its first step) and whenever
@@ -353,6 +421,33 @@ void FixCoulFMM::apply_field()
   }
 }
 
+// efield, polarize, electrode: F_i = q_i E_i + (p_i . grad) E_i and the energy of
+// doc/polarization.md, eq. (3.4), evaluated every step; virial as in apply_field()
+void FixCoulFMM::post_force_polarizable()
+{
+  energy_local = polarizable->evaluate(field, polar_force);
+  energy_summed = false;
+  nevaluations++;
+  double **x = atom->x, **f = atom->f;
+  const bool in_plane = opts->boundary != gcfmm::Boundary::Periodic2D;
+  for (int i = 0; i < atom->nlocal; i++) {
+    if (!(atom->mask[i] & groupbit)) continue;
+    const double fx = polar_force[i][0], fy = polar_force[i][1], fz = polar_force[i][2];
+    f[i][0] += fx;
+    f[i][1] += fy;
+    f[i][2] += fz;
+    if (!evflag) continue;
+    double v[6] = {in_plane ? fx * x[i][0] : 0.0,
+                   in_plane ? fy * x[i][1] : 0.0,
+                   fz * x[i][2],
+                   in_plane ? fy * x[i][0] : 0.0,
+                   in_plane ? fz * x[i][0] : 0.0,
+                   in_plane ? fz * x[i][1] : 0.0};
+    v_tally(i, v);
+  }
+  remember_positions();
+}
+
 // with static sleepers, plus their pair energy with the awake charges and among themselves
 double FixCoulFMM::compute_scalar()
 {
@@ -368,11 +463,12 @@ double FixCoulFMM::compute_scalar()
 // doc/fix_coul_fmm.md, "Output": 1-4 solver (error estimate, order, M2L, P2P), 5-7 keyword
 // check (last, largest, all checks), 8 interval, 9 the MTS error at the last evaluation that
 // continued a field, 10 evaluations, 11 bytes received by the busiest rank in the last
-// evaluation, 12 the largest solver memory of a rank (bytes)
+// evaluation, 12 the largest solver memory of a rank (bytes), 13-14 the induced dipoles
+// iterations and residual at the last evaluation (polarize)
 double FixCoulFMM::compute_vector(int n)
 {
   const auto &d = evaluator->diagnostics_of_last();
-  const double values[12] = {d.estimated_error,
+  const double values[14] = {d.estimated_error,
                              (double) d.order,
                              d.m2l,
                              d.p2p,
@@ -383,48 +479,51 @@ double FixCoulFMM::compute_vector(int n)
                              stepping->last_estimate(),
                              (double) nevaluations,
                              d.bytes_received,
-                             d.solver_memory};
-  return n >= 0 && n < 12 ? values[n] : 0.0;
+                             d.solver_memory,
+                             polarizable ? (double) polarizable->iterations() : 0.0,
+                             polarizable ? polarizable->residual() : 0.0};
+  return n >= 0 && n < 14 ? values[n] : 0.0;
 }
 
 double FixCoulFMM::memory_usage()
 {
-  return (4.0 + MTS::COLS) * atom->nmax * sizeof(double) + near->memory_usage() +
-      evaluator->memory_usage();
+  return (field_cols + 3.0 + MTS::COLS) * atom->nmax * sizeof(double) + near->memory_usage() +
+      evaluator->memory_usage() + (polarizable ? polarizable->memory_usage() : 0.0);
 }
 
 void FixCoulFMM::grow_arrays(int nmax)
 {
-  memory->grow(field, nmax, 4, "coul/fmm:field");
+  memory->grow(field, nmax, field_cols, "coul/fmm:field");
+  memory->grow(polar_force, nmax, 3, "coul/fmm:polar_force");
   memory->grow(eval_state, nmax, MTS::COLS, "coul/fmm:eval_state");
   array_atom = field;
 }
 
 void FixCoulFMM::copy_arrays(int i, int j, int /*delflag*/)
 {
-  for (int k = 0; k < 4; k++) field[j][k] = field[i][k];
+  for (int k = 0; k < field_cols; k++) field[j][k] = field[i][k];
   for (int k = 0; k < MTS::COLS; k++) eval_state[j][k] = eval_state[i][k];
 }
 
 // a created atom has no stored field; its charge 0 in eval_state marks it as new
 void FixCoulFMM::set_arrays(int i)
 {
-  for (int k = 0; k < 4; k++) field[i][k] = 0.0;
+  for (int k = 0; k < field_cols; k++) field[i][k] = 0.0;
   for (int k = 0; k < MTS::COLS; k++) eval_state[i][k] = 0.0;
 }
 
 int FixCoulFMM::pack_exchange(int i, double *buf)
 {
-  for (int k = 0; k < 4; k++) buf[k] = field[i][k];
-  for (int k = 0; k < MTS::COLS; k++) buf[4 + k] = eval_state[i][k];
-  return 4 + MTS::COLS;
+  for (int k = 0; k < field_cols; k++) buf[k] = field[i][k];
+  for (int k = 0; k < MTS::COLS; k++) buf[field_cols + k] = eval_state[i][k];
+  return field_cols + MTS::COLS;
 }
 
 int FixCoulFMM::unpack_exchange(int nlocal, double *buf)
 {
-  for (int k = 0; k < 4; k++) field[nlocal][k] = buf[k];
-  for (int k = 0; k < MTS::COLS; k++) eval_state[nlocal][k] = buf[4 + k];
-  return 4 + MTS::COLS;
+  for (int k = 0; k < field_cols; k++) field[nlocal][k] = buf[k];
+  for (int k = 0; k < MTS::COLS; k++) eval_state[nlocal][k] = buf[field_cols + k];
+  return field_cols + MTS::COLS;
 }
 
 int FixCoulFMM::pack_forward_comm(int n, int *list_send, double *buf, int /*pbc_flag*/,
@@ -473,6 +572,7 @@ void FixCoulFMM::unpack_restart(int nlocal, int nth)
   const int cols = MIN(MTS::COLS, MAX(MTS::COLS_V1, static_cast<int>(extra[nlocal][m]) - 5));
   m++;
   for (int k = 0; k < 4; k++) field[nlocal][k] = extra[nlocal][m++];
+  for (int k = 4; k < field_cols; k++) field[nlocal][k] = 0.0;
   for (int k = 0; k < MTS::COLS; k++) eval_state[nlocal][k] = k < cols ? extra[nlocal][m++] : 0.0;
 }
 

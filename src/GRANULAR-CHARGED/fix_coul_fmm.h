@@ -32,6 +32,7 @@ struct Options;
 namespace LAMMPS_NS {
 class CoulFMMComm;
 class CoulFMMEvaluator;
+class CoulFMMPolarizable;
 
 // Coulomb forces between the charged atoms of a group by the FMM core library (src/fmm):
 // free space (boundary f f f) or periodic in x and y and open in z (boundary p p f). The fix is
@@ -73,6 +74,10 @@ class FixCoulFMM : public Fix {
   std::unique_ptr<CoulFMMEvaluator> evaluator;    // atoms -> solver -> field
   std::unique_ptr<CoulFMMComm> mpi;
   std::unique_ptr<class CoulFMMNearRefresh> near;    // the near refresh's list and buffers
+  // keywords efield, polarize, electrode: every step by gcfmm::PolarizableSolver (null if none)
+  std::unique_ptr<CoulFMMPolarizable> polarizable;
+  int field_cols;                  // per-atom columns: 4, or 7 with the dipole
+  double **polar_force;            // per atom: q E + (p . grad) E of the last evaluation
   bool bed_given;                  // bed zlo/zhi given by the user (farfield average)
   std::string periodic_keyword;    // last of images/farfield given (ignored in free space)
   bool sleepers_static;            // keyword sleepers: static (true) or full
@@ -96,6 +101,7 @@ class FixCoulFMM : public Fix {
   void advance_field();
   void apply_field();
   void remember_positions();
+  void post_force_polarizable();
 };
 
 }    // namespace LAMMPS_NS

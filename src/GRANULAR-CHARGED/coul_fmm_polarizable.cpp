@@ -1,0 +1,191 @@
+/* ----------------------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+#include "coul_fmm_polarizable.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "domain.h"
+#include "error.h"
+#include "force.h"
+
+#include "gcfmm/dipole_kernels.hpp"
+#include "gcfmm/far_field.hpp"
+#include "gcfmm/polarizable_solver.hpp"
+#include "gcfmm/solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <numeric>
+
+using namespace LAMMPS_NS;
+
+CoulFMMPolarizable::CoulFMMPolarizable(LAMMPS *lmp, const Settings &settings, int groupbit_) :
+    Pointers(lmp), s(settings), groupbit(groupbit_)
+{
+}
+
+CoulFMMPolarizable::~CoulFMMPolarizable() = default;
+
+void CoulFMMPolarizable::init(const gcfmm::Options &opts)
+{
+  if (s.polarize && !atom->radius_flag)
+    error->all(FLERR,
+               "Fix coul/fmm polarize requires per-atom radii (an atom style with radius, "
+               "e.g. sphere)");
+  // the bare kernel times qqrd2e is the Coulomb law in the medium of the dielectric command,
+  // whose permittivity the polarizability (doc/polarization.md, eq. (3.2)) must use too
+  if (s.polarize && s.eps_medium > 0.0 && std::fabs(s.eps_medium - force->dielectric) > 1e-12 * s.eps_medium)
+    error->all(FLERR,
+               "Fix coul/fmm polarize: medium permittivity {:g} differs from the dielectric "
+               "command's {:g}, which scales every Coulomb force; set dielectric {:g}",
+               s.eps_medium, force->dielectric, s.eps_medium);
+  if (s.electrode && s.electrode_z >= domain->boxhi[2])
+    error->all(FLERR, "Fix coul/fmm electrode {:g} is not below the box top {:g}", s.electrode_z,
+               domain->boxhi[2]);
+  periodic = opts.boundary == gcfmm::Boundary::Periodic2D;
+  if (periodic && opts.farfield == gcfmm::FarField::Average)
+    error->all(FLERR,
+               "Fix coul/fmm efield, polarize and electrode need farfield exact or none (the "
+               "average far field smears charges only)");
+  gcfmm::PolarizationSettings induction;
+  induction.tolerance = s.tolerance > 0.0 ? s.tolerance : 0.1 * opts.accuracy;
+  solver = std::make_unique<gcfmm::PolarizableSolver>(opts);
+  solver->set_induction(induction);
+  gcfmm::PolarizableEnvironment env;
+  // LAMMPS field units (force = qe2f q E) -> bare units (force = qqrd2e q E_bare)
+  const double to_bare = force->qe2f / force->qqrd2e;
+  env.applied_field = {to_bare * s.field[0], to_bare * s.field[1], to_bare * s.field[2]};
+  env.electrode = s.electrode;
+  env.electrode_z = s.electrode_z;
+  solver->set_environment(env);
+}
+
+// every rank: the group's atoms of all ranks, sorted by ID
+void CoulFMMPolarizable::gather()
+{
+  const int nlocal = atom->nlocal;
+  const int per = 6;
+  std::vector<double> mine;
+  const double beta = s.polarize
+      ? gcfmm::clausius_mossotti(s.eps_particle, s.eps_medium > 0.0 ? s.eps_medium : force->dielectric)
+      : 0.0;
+  for (int i = 0; i < nlocal; i++) {
+    if (!(atom->mask[i] & groupbit)) continue;
+    double xu[3];
+    domain->unmap(atom->x[i], atom->image[i], xu);
+    const double alpha = s.polarize ? gcfmm::polarizability(beta, atom->radius[i]) : 0.0;
+    const double v[per] = {(double) atom->tag[i], periodic ? atom->x[i][0] : xu[0],
+                           periodic ? atom->x[i][1] : xu[1], xu[2], atom->q[i], alpha};
+    mine.insert(mine.end(), v, v + per);
+  }
+  int count = (int) mine.size(), nprocs = comm->nprocs;
+  std::vector<int> counts(nprocs), displs(nprocs, 0);
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
+  for (int r = 1; r < nprocs; r++) displs[r] = displs[r - 1] + counts[r - 1];
+  std::vector<double> all(displs[nprocs - 1] + counts[nprocs - 1]);
+  MPI_Allgatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(),
+                 MPI_DOUBLE, world);
+  const size_t n = all.size() / per;
+  std::vector<size_t> order(n);
+  std::iota(order.begin(), order.end(), size_t(0));
+  std::sort(order.begin(), order.end(),
+            [&](size_t a, size_t b) { return all[per * a] < all[per * b]; });
+  gtag.resize(n);
+  for (auto *v : {&gx, &gy, &gz, &gq, &galpha}) v->resize(n);
+  for (size_t k = 0; k < n; k++) {
+    const double *a = &all[per * order[k]];
+    gtag[k] = (tagint) a[0];
+    gx[k] = a[1];
+    gy[k] = a[2];
+    gz[k] = a[3];
+    gq[k] = a[4];
+    galpha[k] = a[5];
+  }
+}
+
+double CoulFMMPolarizable::evaluate(double **field, double **force_out)
+{
+  gather();
+  const size_t n = gtag.size();
+  const int cols = s.polarize ? 7 : 4;    // the fix's per-atom columns
+  for (int i = 0; i < atom->nlocal; i++) {
+    for (int k = 0; k < cols; k++) field[i][k] = 0.0;
+    for (int k = 0; k < 3; k++) force_out[i][k] = 0.0;
+  }
+  if (n == 0) return 0.0;
+  // warm start: the last solution of the atoms that are still there (both lists sorted by ID)
+  gp.assign(3 * n, 0.0);
+  for (size_t k = 0, m = 0; k < n && m < last_tag.size(); k++) {
+    while (m < last_tag.size() && last_tag[m] < gtag[k]) m++;
+    if (m < last_tag.size() && last_tag[m] == gtag[k])
+      for (int a = 0; a < 3; a++) gp[3 * k + a] = last_p[3 * m + a];
+  }
+  gcfmm::PolarizableOutputs out;
+  std::string failure;
+  try {
+    if (periodic) {
+      solver->set_box(domain->boxlo[0], domain->boxlo[1], domain->xprd, domain->yprd);
+      solver->set_z_range(domain->boxlo[2], domain->boxhi[2]);
+    }
+    solver->compute(n, gx.data(), gy.data(), gz.data(), gq.data(),
+                    s.polarize ? galpha.data() : nullptr, gp.data(), out);
+  } catch (gcfmm::CoincidentParticles &e) {
+    // the solver's sources are the atoms, then (with an electrode) their images
+    failure = fmt::format("atoms {} and {} are at the same position: their Coulomb force is not "
+                          "defined", gtag[e.first() % n], gtag[e.second() % n]);
+  } catch (std::exception &e) {
+    failure = e.what();
+  }
+  // every rank solved the same system, so every rank sees the same failure
+  if (!failure.empty()) {
+    // the solver names the particle by its index in the sorted list: name the atom instead
+    for (size_t k = 0; k < n; k++)
+      if (s.electrode && !(gz[k] > s.electrode_z)) {
+        failure = fmt::format("atom {} (z = {:g}) is not above the electrode (z = {:g})", gtag[k],
+                              gz[k], s.electrode_z);
+        break;
+      }
+    error->all(FLERR, "Fix coul/fmm: {}", failure);
+  }
+  const auto &rep = solver->report();
+  last_iterations = rep.iterations;
+  last_residual = rep.residual;
+  if (s.polarize && !rep.converged)
+    error->all(FLERR,
+               "Fix coul/fmm polarize: the induced dipoles did not converge (residual {:.3g} > "
+               "{:.3g} after {} iterations): the particles overlap too much for point dipoles",
+               rep.residual, s.tolerance > 0.0 ? s.tolerance : 0.1 * solver->options().accuracy,
+               rep.iterations);
+  last_tag = gtag;
+  last_p = gp;
+
+  // this rank's atoms (binary search by ID in the sorted list); bare -> LAMMPS units
+  const double c = force->qqrd2e;
+  double energy = 0.0;
+  for (int i = 0; i < atom->nlocal; i++) {
+    if (!(atom->mask[i] & groupbit)) continue;
+    const size_t k = std::lower_bound(gtag.begin(), gtag.end(), atom->tag[i]) - gtag.begin();
+    for (int a = 0; a < 3; a++) {
+      field[i][a] = c * out.field[3 * k + a];
+      if (s.polarize) field[i][4 + a] = gp[3 * k + a];
+      force_out[i][a] = c * out.force[3 * k + a];
+    }
+    field[i][3] = atom->q[i] != 0.0 ? 2.0 * c * out.energy[k] / atom->q[i] : 0.0;
+    energy += c * out.energy[k];
+  }
+  return energy;
+}
+
+double CoulFMMPolarizable::memory_usage() const
+{
+  return (double) (gx.capacity() * 6 + gp.capacity() + last_p.capacity()) * sizeof(double) +
+      (double) (gtag.capacity() + last_tag.capacity()) * sizeof(tagint);
+}

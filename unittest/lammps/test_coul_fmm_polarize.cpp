@@ -1,0 +1,243 @@
+/* GRANULAR-CHARGED: the keywords efield, polarize and electrode of fix coul/fmm against
+   LAMMPS's fix efield, closed forms (the image force of a charge above a grounded plane, two
+   mutually inducing dielectric spheres in a field), the energy's derivative, and 1 vs 2 ranks.
+   Units real: qqr2e = 332.06371, fields in V/A (qe2f = 23.060549, as fix efield). */
+#include "gc_testing.h"
+
+#include "library.h"
+#include "gtest/gtest.h"
+
+#include <cmath>
+#include <regex>
+#include <string>
+#include <vector>
+
+using gctest::Lmp;
+using gctest::error_of;
+using gctest::gather;
+using gctest::rel_rms;
+
+namespace {
+
+const double kQqr2e = 332.06371, kQe2f = 23.060549;
+
+// spheres of radius 1 (diameter 2) with charges, in a box above z = 0
+void spheres(Lmp &l, const std::string &boundary, const std::vector<std::vector<double>> &xyzq,
+             double lx = 20.0)
+{
+  l.cmds({"units real", "atom_style hybrid sphere charge", "atom_modify map array sort 0 0",
+          "boundary " + boundary, fmt::format("region box block 0 {} 0 {} 0 30", lx, lx),
+          "create_box 1 box", "neighbor 1.0 bin", "thermo_style custom step pe",
+          "thermo_modify norm no", "pair_style zero 5.0", "pair_coeff * *"});
+  for (size_t k = 0; k < xyzq.size(); k++)
+    l.cmds({fmt::format("create_atoms 1 single {} {} {} units box", xyzq[k][0], xyzq[k][1], xyzq[k][2]),
+            fmt::format("set atom {} charge {} diameter 2.0 density 1.0", k + 1, xyzq[k][3])});
+}
+
+std::vector<std::vector<double>> random_spheres(int n, int seed, double lx)
+{
+  // a jittered lattice of spacing 3 (no overlaps) from z = 2, charges of both signs
+  std::vector<std::vector<double>> a;
+  unsigned s = seed;
+  auto u = [&s]() { s = s * 1103515245u + 12345u; return ((s >> 8) & 0xffff) / 65536.0; };
+  const int m = int(lx / 3.0);
+  for (int k = 0; k < n; k++)
+    a.push_back({1.5 + 3.0 * (k % m) + 0.3 * (u() - 0.5), 1.5 + 3.0 * ((k / m) % m) + 0.3 * (u() - 0.5),
+                 2.0 + 3.0 * (k / (m * m)) + 0.3 * (u() - 0.5), u() - 0.5});
+  return a;
+}
+
+}    // namespace
+
+// efield acts on the charges as LAMMPS's fix efield does (same units, force = qe2f q E); the
+// energy -qe2f q E . (r - r0) is zero at the origin (no electrode) as fix efield's
+TEST(CoulFMMPolarize, EfieldMatchesFixEfield)
+{
+  Lmp a, b;
+  const auto atoms = random_spheres(40, 3, 12.0);
+  spheres(a, "f f f", atoms, 12.0);
+  spheres(b, "f f f", atoms, 12.0);
+  a.cmds({"fix fmm all coul/fmm accuracy 1e-8 efield 0.1 -0.2 0.3", "run 0 post no"});
+  b.cmds({"fix fmm all coul/fmm accuracy 1e-8", "fix ef all efield 0.1 -0.2 0.3", "run 0 post no"});
+  const auto fa = gather(a, "f", 3), fb = gather(b, "f", 3);
+  EXPECT_LT(rel_rms(fa, fb), 1e-10);
+}
+
+// one charge at height h above the grounded electrode: F_z = -qqr2e q^2 / (4 h^2), energy
+// -qqr2e q^2 / (4 h) (q^2 / (16 pi eps0 h^2) in SI) in free space; with p p f the periodic
+// copies of the image add their pull (the copies of the charge pull only sideways, and cancel),
+// which includes the image layer's sheet field (a capacitor's). Seen: 1e-8 relative.
+TEST(CoulFMMPolarize, ChargeAboveElectrode)
+{
+  for (const std::string bc : {"f f f", "p p f"}) {
+    Lmp l;
+    const double q = 1.5, z0 = 1.0, h = 2.5, L = 20.0;
+    spheres(l, bc, {{5.0, 5.0, z0 + h, q}}, L);
+    l.cmds({fmt::format("fix fmm all coul/fmm accuracy 1e-8 electrode {}", z0), "fix_modify fmm energy yes",
+            "run 0 post no"});
+    const auto f = gather(l, "f", 3);
+    double fz = -q * q / (4 * h * h), u = -q * q / (4 * h);
+    if (bc == "p p f") {
+      // the image copies' pull over (2K + 1)^2 cells plus the continuum outside the disk of the
+      // same area; the square's corners make that O(1/K), removed by Richardson from K and 2K
+      auto images_pull = [&](int K) {
+        double s = 0.0;
+        for (int a = -K; a <= K; a++)
+          for (int b = -K; b <= K; b++) {
+            if (a == 0 && b == 0) continue;
+            const double ri = 1.0 / std::sqrt(L * L * (a * a + b * b) + 4 * h * h);
+            s -= q * q * 2 * h * ri * ri * ri;
+          }
+        const double R = (2 * K + 1) * L / std::sqrt(M_PI);
+        return s - q * q * 2 * h * 2 * M_PI / (L * L * std::sqrt(R * R + 4 * h * h));
+      };
+      fz += 2.0 * images_pull(400) - images_pull(200);
+    }
+    EXPECT_NEAR(f[2], kQqr2e * fz, 1e-7 * kQqr2e * std::fabs(fz)) << bc;
+    EXPECT_NEAR(f[0], 0.0, 1e-7 * kQqr2e * std::fabs(fz)) << bc;
+    if (bc == "f f f") EXPECT_NEAR(l.var("f_fmm"), kQqr2e * u, 1e-7 * kQqr2e * std::fabs(u)) << bc;
+    std::printf("[ electrode ] %s: F_z %.10g, reference %.10g\n", bc.c_str(), f[2], kQqr2e * fz);
+  }
+}
+
+// two uncharged dielectric spheres (radius 1, eps_p = 4: beta = 1/2, alpha = 1/2 A^3) on the
+// field's axis at distance d: each carries p = alpha E / (1 - 2 alpha / d^3) and they attract
+// with F = 6 p^2 / d^4 (point dipoles; bare units times qqr2e, E in bare units
+// qe2f E / qqr2e); across the field p = alpha E / (1 + alpha / d^3), F = -3 p^2 / d^4 (repulsion)
+TEST(CoulFMMPolarize, TwoSpheresInAField)
+{
+  const double E = 0.5, alpha = 0.5;
+  for (const double d : {2.2, 3.0, 5.0}) {
+    for (const bool along : {true, false}) {
+      Lmp l;
+      spheres(l, "f f f", {{5.0, 5.0, 5.0, 0.0}, {along ? 5.0 : 5.0 + d, 5.0, along ? 5.0 + d : 5.0, 0.0}});
+      l.cmds({"fix fmm all coul/fmm accuracy 1e-8 polarize 4.0 efield 0 0 0.5", "run 0 post no"});
+      const auto f = gather(l, "f", 3);
+      const double eb = kQe2f * E / kQqr2e;
+      const double p = along ? alpha * eb / (1 - 2 * alpha / std::pow(d, 3)) : alpha * eb / (1 + alpha / std::pow(d, 3));
+      const double F = kQqr2e * (along ? 6.0 : -3.0) * p * p / std::pow(d, 4);
+      // the force on sphere 2 along the line from 1 to 2: -F (attraction) / +3p^2/d^4 (repulsion)
+      const double got = along ? f[5] : f[3];
+      EXPECT_NEAR(got, -F, 1e-7 * std::fabs(F)) << "d = " << d << (along ? " along" : " across");
+      EXPECT_NEAR(got, -(along ? f[2] : f[0]), 1e-7 * std::fabs(F)) << "Newton's third law";
+      EXPECT_NEAR(l.var("f_fmm[13]") > 0 ? 1.0 : 0.0, 1.0, 0.0) << "iterations reported";
+    }
+  }
+}
+
+// everything on (charges, polarize, efield, electrode, p p f with the exact far field):
+// F = -dU/dx by central differences of the fix energy (step 1e-4 A: truncation ~1e-8 of the
+// force; the energy's FMM error at accuracy 1e-10 over 27 atoms, divided by the step, is ~1e-5
+// of a force), and the same forces on 1 and 2 ranks
+TEST(CoulFMMPolarize, ForceIsMinusEnergyGradient)
+{
+  const auto atoms = random_spheres(27, 11, 9.0);
+  auto energy = [&](int atom, int dim, double dx) {
+    auto moved = atoms;
+    moved[atom][dim] += dx;
+    Lmp l;
+    spheres(l, "p p f", moved, 9.0);
+    l.cmds({"fix fmm all coul/fmm accuracy 1e-10 polarize 3.8 efield 0.05 0.02 0.4 electrode 0.5",
+            "fix_modify fmm energy yes", "run 0 post no"});
+    return l.var("f_fmm");
+  };
+  Lmp l;
+  spheres(l, "p p f", atoms, 9.0);
+  l.cmds({"fix fmm all coul/fmm accuracy 1e-10 polarize 3.8 efield 0.05 0.02 0.4 electrode 0.5",
+          "fix_modify fmm energy yes", "run 0 post no"});
+  const auto f = gather(l, "f", 3);
+  const double h = 1e-4;
+  for (const int k : {4, 13, 22}) {
+    double fmax = 0.0;
+    for (int a = 0; a < 3; a++) fmax = std::max(fmax, std::fabs(f[3 * k + a]));
+    for (int a = 0; a < 3; a++) {
+      const double fd = -(energy(k, a, h) - energy(k, a, -h)) / (2 * h);
+      EXPECT_NEAR(f[3 * k + a], fd, 1e-4 * fmax) << "atom " << k + 1 << " component " << a;
+    }
+  }
+}
+
+// a short run with every keyword continued from a restart file: the same trajectory (the
+// induction starts cold after read_restart, the same solution to its tolerance)
+TEST(CoulFMMPolarize, RestartContinuesTheRun)
+{
+  const auto atoms = random_spheres(27, 5, 9.0);
+  const std::string fix = "fix fmm all coul/fmm accuracy 1e-8 polarize 3.8 efield 0 0 0.4 electrode 0.5";
+  auto setup = [&](Lmp &l) {
+    spheres(l, "p p f", atoms, 9.0);
+    l.cmds({fix, "fix_modify fmm energy yes", "fix nve all nve/sphere", "timestep 0.1"});
+  };
+  Lmp l;
+  setup(l);
+  l.cmds({"run 20 post no"});
+  const auto f = gather(l, "f", 3);
+  const auto x = gather(l, "x", 3);
+  EXPECT_GT(l.var("f_fmm[13]"), 0.0);
+  EXPECT_LT(l.var("f_fmm[14]"), 1e-9);
+  const std::string file = fmt::format("polarize.{}.restart", gctest::nprocs());
+  Lmp r;
+  setup(r);
+  r.cmds({"run 10 post no", "write_restart " + file});
+  Lmp c;
+  c.cmds({"read_restart " + file, "pair_style zero 5.0", "pair_coeff * *", fix, "fix nve all nve/sphere",
+          "timestep 0.1", "run 10 post no"});
+  EXPECT_LT(rel_rms(gather(c, "x", 3), x), 1e-9);
+  EXPECT_LT(rel_rms(gather(c, "f", 3), f), 1e-5);
+}
+
+// 2 ranks against 1: every rank solves the same gathered system (sorted by ID), so the
+// forces, energy and per-atom dipoles agree to round-off
+TEST(CoulFMMPolarize, OneVersusTwoRanks)
+{
+  if (gctest::nprocs() != 2) GTEST_SKIP() << "needs mpirun -np 2";
+  const auto atoms = random_spheres(40, 9, 12.0);
+  auto run = [&](MPI_Comm comm) {
+    Lmp l(comm);
+    spheres(l, "p p f", atoms, 12.0);
+    l.cmds({"fix fmm all coul/fmm accuracy 1e-6 polarize 3.8 efield 0 0 0.4 electrode 0.5",
+            "fix_modify fmm energy yes", "run 0 post no"});
+    auto f = gather(l, "f", 3);
+    std::vector<double> p(7 * atoms.size());    // per-atom field, potential, dipole
+    lammps_gather(l.lmp, (char *) "f_fmm", 1, 7, p.data());
+    f.insert(f.end(), p.begin(), p.end());
+    f.push_back(l.var("f_fmm"));
+    return f;
+  };
+  const auto two = run(MPI_COMM_WORLD);
+  int me;
+  MPI_Comm_rank(MPI_COMM_WORLD, &me);
+  std::vector<double> one(two.size());
+  if (me == 0) one = run(MPI_COMM_SELF);
+  MPI_Bcast(one.data(), (int) one.size(), MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  EXPECT_LT(rel_rms(two, one), 1e-12);
+}
+
+TEST(CoulFMMPolarize, BadInput)
+{
+  auto with = [](const std::string &style, const std::string &fix, const std::string &z = "5",
+                 const std::string &extra = "") {
+    std::vector<std::string> c = {"units real", "atom_style " + style, "boundary p p f",
+                                  "region box block 0 10 0 10 0 10", "create_box 1 box",
+                                  "create_atoms 1 single 1 1 " + z, "mass 1 1", "pair_style zero 2.0",
+                                  "pair_coeff * *", fix};
+    if (!extra.empty()) c.push_back(extra);
+    c.push_back("run 0 post no");
+    return error_of(c);
+  };
+  auto expect_match = [](const std::string &msg, const std::string &re) {
+    EXPECT_TRUE(std::regex_search(msg, std::regex(re))) << "message: " << msg << "\nexpected: " << re;
+  };
+  const std::string sph = "hybrid sphere charge";
+  expect_match(with(sph, "fix fmm all coul/fmm polarize 0"), "permittivities must be > 0, got 0");
+  expect_match(with(sph, "fix fmm all coul/fmm polarize -2 1"), "permittivities must be > 0, got -2 1");
+  expect_match(with("charge", "fix fmm all coul/fmm polarize 4"), "polarize requires per-atom radii");
+  expect_match(with(sph, "fix fmm all coul/fmm polarize 4 2"), "medium permittivity 2 differs from the dielectric");
+  expect_match(with(sph, "fix fmm all coul/fmm electrode 12"), "electrode 12 is not below the box top 10");
+  expect_match(with(sph, "fix fmm all coul/fmm electrode 6"), "atom 1 \\(z = 5\\) is not above the electrode \\(z = 6\\)");
+  expect_match(with(sph, "fix fmm all coul/fmm efield 0 0"), "Illegal fix coul/fmm efield command: missing argument");
+  expect_match(with(sph, "fix fmm all coul/fmm induction 1e-6"), "induction needs polarize");
+  expect_match(with(sph, "fix fmm all coul/fmm polarize 4 solver distributed"), "need solver replicated");
+  expect_match(with(sph, "fix fmm all coul/fmm polarize 4 farfield average"), "need farfield exact or none");
+  expect_match(with(sph, "fix fmm all coul/fmm efield 0 0 1", "5", "fix ef all efield 0 0 1"), "would both apply the field");
+  expect_match(with(sph, "fix fmm all coul/fmm polarize 4", "5", "fix ef all efield 0 0 1"), "would not polarize the particles");
+}
