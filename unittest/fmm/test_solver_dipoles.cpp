@@ -535,3 +535,23 @@ TEST(PolarizableSolver, ForceIsMinusEnergyGradientWithExactFarField)
     }
   }
 }
+
+// FieldOutputs::targets: the first particles get the results of the full evaluation (the same
+// lists and expansions, so to round-off), the others zero
+TEST(SolverDipoles, TargetsSubset)
+{
+  const Sources s = random_sources(3000, 41, 1.0, 1.0);
+  Solver solver(high_accuracy());
+  solver.build(s.size(), s.x.data(), s.y.data(), s.z.data());
+  Result all(s.size()), some(s.size());
+  solver.evaluate_dipoles(s.view(), all.outputs());
+  FieldOutputs o = some.outputs();
+  o.targets = 1000;
+  solver.evaluate_dipoles(s.view(), o);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const bool target = i < 1000;
+    EXPECT_EQ(some.ez[i], target ? all.ez[i] : 0.0) << i;
+    EXPECT_EQ(some.pot[i], target ? all.pot[i] : 0.0) << i;
+    EXPECT_EQ(some.g[6 * i + 2], target ? all.g[6 * i + 2] : 0.0) << i;
+  }
+}

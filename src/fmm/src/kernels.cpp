@@ -1,7 +1,9 @@
 // GRANULAR-CHARGED FMM core library (gcfmm): P2P kernel and direct reference sums.
 #include "gcfmm/kernels.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -229,98 +231,143 @@ void direct_images(std::size_t n, const double *x, const double *y, const double
 
 namespace {
 
-// Sources [0, ns) at targets [0, nt): the terms of dipole_kernels.hpp, vectorised over the
-// sources (omp simd), only those the sources carry. A pair at or inside r2_min (the self term,
-// coincident pairs) is given a harmless displacement and zero weight: the loop has no branch.
+// P2P of charges and dipoles (p2p_dipoles): the terms of dipole_kernels.hpp, only those the
+// sources carry (kCharges, kDipoles) and the gradient only with kGradient.
+#define GCFMM_P2PD_PARAMS                                                                                  \
+  (std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns, const double *xs,       \
+   const double *ys, const double *zs, const double *qs, const double *pxs, const double *pys, const double *pzs, \
+   double sx, double sy, double sz, double *pot, double *ex, double *ey, double *ez, double *g6, double r2_min)
+#define GCFMM_P2PD_ARGS (nt, xt, yt, zt, ns, xs, ys, zs, qs, pxs, pys, pzs, sx, sy, sz, pot, ex, ey, ez, g6, r2_min)
+using p2p_dipoles_fn = void(*) GCFMM_P2PD_PARAMS;
+
+// the gradient of target i, 6 values, added
+template <class F>
+inline void add_gradient(double *g, const F &f) {
+  g[0] += f.gxx;
+  g[1] += f.gxy;
+  g[2] += f.gxz;
+  g[3] += f.gyy;
+  g[4] += f.gyz;
+  g[5] += f.gzz;
+}
+
+// Portable: vectorised over the sources by the compiler (omp simd), exact 1/sqrt; a pair at or
+// inside r2_min gets rinv = 0 (adds nothing) and a harmless distance.
 template <bool kCharges, bool kDipoles, bool kGradient>
-GCFMM_ALWAYS_INLINE void p2p_dipoles_loop(std::size_t nt, const double *xt, const double *yt, const double *zt,
-                                          std::size_t ns, const double *__restrict xs, const double *__restrict ys,
-                                          const double *__restrict zs, const double *__restrict qs,
-                                          const double *__restrict pxs, const double *__restrict pys,
-                                          const double *__restrict pzs, double sx, double sy, double sz,
-                                          double *pot, double *ex, double *ey, double *ez, double *g6,
-                                          double r2_min) {
+inline void p2p_dipoles_loop GCFMM_P2PD_PARAMS {
   for (std::size_t i = 0; i < nt; ++i) {
     const double tx = xt[i] - sx, ty = yt[i] - sy, tz = zt[i] - sz;
     double ap = 0, ax = 0, ay = 0, az = 0, gxx = 0, gxy = 0, gxz = 0, gyy = 0, gyz = 0, gzz = 0;
 #pragma omp simd reduction(+ : ap, ax, ay, az, gxx, gxy, gxz, gyy, gyz, gzz)
     for (std::size_t j = 0; j < ns; ++j) {
-      Vec3 d{tx - xs[j], ty - ys[j], tz - zs[j]};
-      const bool skip = norm2(d) <= r2_min;
-      const double w = skip ? 0.0 : 1.0;
-      if (skip) d = Vec3{1.0, 0.0, 0.0};
-      PointField f;
-      if (kCharges) {
-        if (kGradient)
-          add_charge(w * qs[j], d, f);
-        else
-          add_charge_field(w * qs[j], d, f.pot, f.e);
-      }
-      if (kDipoles) {
-        const Vec3 p{w * pxs[j], w * pys[j], w * pzs[j]};
-        if (kGradient)
-          add_dipole(p, d, f);
-        else
-          add_dipole_field(p, d, f.pot, f.e);
-      }
+      const double dx = tx - xs[j], dy = ty - ys[j], dz = tz - zs[j];
+      const double r2 = dx * dx + dy * dy + dz * dz;
+      const bool keep = r2 > r2_min;
+      const double rinv = keep ? 1.0 / std::sqrt(keep ? r2 : 1.0) : 0.0;
+      FieldTerms<double> f;
+      if (kCharges) charge_terms<kGradient>(qs[j], dx, dy, dz, rinv, f);
+      if (kDipoles) dipole_terms<kGradient>(pxs[j], pys[j], pzs[j], dx, dy, dz, rinv, f);
       ap += f.pot;
-      ax += f.e.x;
-      ay += f.e.y;
-      az += f.e.z;
-      if (kGradient) {
-        gxx += f.g.xx;
-        gxy += f.g.xy;
-        gxz += f.g.xz;
-        gyy += f.g.yy;
-        gyz += f.g.yz;
-        gzz += f.g.zz;
-      }
+      ax += f.ex;
+      ay += f.ey;
+      az += f.ez;
+      gxx += f.gxx;
+      gxy += f.gxy;
+      gxz += f.gxz;
+      gyy += f.gyy;
+      gyz += f.gyz;
+      gzz += f.gzz;
     }
     pot[i] += ap;
     ex[i] += ax;
     ey[i] += ay;
     ez[i] += az;
+    if (kGradient) add_gradient(g6 + 6 * i, FieldTerms<double>{0, 0, 0, 0, gxx, gxy, gxz, gyy, gyz, gzz});
+  }
+}
+
+#if GCFMM_X86_DISPATCH
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+// FieldTerms<__m512d>: the register types' may_alias attribute does not carry into the template
+// argument, which is harmless here (the members are only used as values)
+#pragma GCC diagnostic ignored "-Wignored-attributes"
+// x86: vectorised over the targets of a register, the sources broadcast one by one, 1/sqrt from
+// the hardware estimate and Newton steps (Reg::rsqrt: 0 for dropped pairs), as p2p_rsqrt; the
+// terms run on the register type through GCC's vector operators
+template <class Reg, bool kCharges, bool kDipoles, bool kGradient>
+inline void p2p_dipoles_rsqrt GCFMM_P2PD_PARAMS {
+  using V = typename Reg::V;
+  const V rmin2 = Reg::set1(r2_min);
+  for (std::size_t i = 0; i < nt; i += Reg::kWidth) {
+    const typename Reg::Mask m = Reg::tail(nt - i);
+    const V xi = Reg::load(m, xt + i) - Reg::set1(sx);
+    const V yi = Reg::load(m, yt + i) - Reg::set1(sy);
+    const V zi = Reg::load(m, zt + i) - Reg::set1(sz);
+    FieldTerms<V> f;
+    for (std::size_t j = 0; j < ns; ++j) {
+      const V dx = xi - Reg::set1(xs[j]), dy = yi - Reg::set1(ys[j]), dz = zi - Reg::set1(zs[j]);
+      const V rinv = Reg::rsqrt(dx * dx + dy * dy + dz * dz, rmin2);
+      if (kCharges) charge_terms<kGradient>(Reg::set1(qs[j]), dx, dy, dz, rinv, f);
+      if (kDipoles) dipole_terms<kGradient>(Reg::set1(pxs[j]), Reg::set1(pys[j]), Reg::set1(pzs[j]), dx, dy, dz, rinv, f);
+    }
+    Reg::add_store(m, pot + i, f.pot);
+    Reg::add_store(m, ex + i, f.ex);
+    Reg::add_store(m, ey + i, f.ey);
+    Reg::add_store(m, ez + i, f.ez);
     if (kGradient) {
-      double *g = g6 + 6 * i;
-      g[0] += gxx;
-      g[1] += gxy;
-      g[2] += gxz;
-      g[3] += gyy;
-      g[4] += gyz;
-      g[5] += gzz;
+      double g[6][Reg::kWidth];
+      const V *parts[6] = {&f.gxx, &f.gxy, &f.gxz, &f.gyy, &f.gyz, &f.gzz};
+      for (int c = 0; c < 6; ++c) std::memcpy(g[c], parts[c], sizeof(V));
+      const std::size_t lanes = std::min<std::size_t>(Reg::kWidth, nt - i);
+      for (std::size_t l = 0; l < lanes; ++l)
+        for (int c = 0; c < 6; ++c) g6[6 * (i + l) + c] += g[c][l];
     }
   }
 }
+#pragma GCC diagnostic pop
+#endif
 
-// the instance of what the sources carry (charges, dipoles) and whether the gradient is asked
-GCFMM_ALWAYS_INLINE void p2p_dipoles_body(std::size_t nt, const double *xt, const double *yt, const double *zt,
-                                          std::size_t ns, const double *xs, const double *ys, const double *zs,
-                                          const double *qs, const double *pxs, const double *pys,
-                                          const double *pzs, double sx, double sy, double sz, double *pot,
-                                          double *ex, double *ey, double *ez, double *g6, double r2_min,
-                                          bool charges, bool dipoles) {
-#define GCFMM_P2P_DIPOLES(C, D, G) \
-  p2p_dipoles_loop<C, D, G>(nt, xt, yt, zt, ns, xs, ys, zs, qs, pxs, pys, pzs, sx, sy, sz, pot, ex, ey, ez, g6, r2_min)
-  if (g6) {
-    if (charges && dipoles) GCFMM_P2P_DIPOLES(true, true, true);
-    else if (charges) GCFMM_P2P_DIPOLES(true, false, true);
-    else if (dipoles) GCFMM_P2P_DIPOLES(false, true, true);
-  } else {
-    if (charges && dipoles) GCFMM_P2P_DIPOLES(true, true, false);
-    else if (charges) GCFMM_P2P_DIPOLES(true, false, false);
-    else if (dipoles) GCFMM_P2P_DIPOLES(false, true, false);
+// the instance of what the sources carry
+#define GCFMM_P2PD_CHOOSE(KERNEL)                                        \
+  if (g6) {                                                              \
+    if (charges && dipoles) KERNEL(true, true, true);                    \
+    else if (charges) KERNEL(true, false, true);                         \
+    else if (dipoles) KERNEL(false, true, true);                         \
+  } else {                                                               \
+    if (charges && dipoles) KERNEL(true, true, false);                   \
+    else if (charges) KERNEL(true, false, false);                        \
+    else if (dipoles) KERNEL(false, true, false);                        \
   }
-#undef GCFMM_P2P_DIPOLES
-}
 
-GCFMM_DEFINE_SIMD_PATHS(void, p2p_dipoles_path,
-                        (std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
+#define GCFMM_P2PD_GENERIC(C, D, G) p2p_dipoles_loop<C, D, G> GCFMM_P2PD_ARGS
+void p2p_dipoles_generic(std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
                          const double *xs, const double *ys, const double *zs, const double *qs, const double *pxs,
                          const double *pys, const double *pzs, double sx, double sy, double sz, double *pot,
-                         double *ex, double *ey, double *ez, double *g6, double r2_min, bool charges, bool dipoles),
-                        p2p_dipoles_body,
-                        (nt, xt, yt, zt, ns, xs, ys, zs, qs, pxs, pys, pzs, sx, sy, sz, pot, ex, ey, ez, g6, r2_min,
-                         charges, dipoles))
+                         double *ex, double *ey, double *ez, double *g6, double r2_min, bool charges, bool dipoles) {
+  GCFMM_P2PD_CHOOSE(GCFMM_P2PD_GENERIC)
+}
+#if GCFMM_X86_DISPATCH
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+#define GCFMM_P2PD_AVX512(C, D, G) p2p_dipoles_rsqrt<Avx512, C, D, G> GCFMM_P2PD_ARGS
+#define GCFMM_P2PD_AVX2(C, D, G) p2p_dipoles_rsqrt<Avx2, C, D, G> GCFMM_P2PD_ARGS
+__attribute__((flatten)) GCFMM_TARGET_AVX512 void p2p_dipoles_avx512(
+    std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns, const double *xs,
+    const double *ys, const double *zs, const double *qs, const double *pxs, const double *pys, const double *pzs,
+    double sx, double sy, double sz, double *pot, double *ex, double *ey, double *ez, double *g6, double r2_min,
+    bool charges, bool dipoles) {
+  GCFMM_P2PD_CHOOSE(GCFMM_P2PD_AVX512)
+}
+__attribute__((flatten)) GCFMM_TARGET_AVX2 void p2p_dipoles_avx2(
+    std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns, const double *xs,
+    const double *ys, const double *zs, const double *qs, const double *pxs, const double *pys, const double *pzs,
+    double sx, double sy, double sz, double *pot, double *ex, double *ey, double *ez, double *g6, double r2_min,
+    bool charges, bool dipoles) {
+  GCFMM_P2PD_CHOOSE(GCFMM_P2PD_AVX2)
+}
+#pragma GCC diagnostic pop
+#endif
 
 }  // namespace
 
@@ -338,8 +385,19 @@ void p2p_dipoles(std::size_t nt, const double *xt, const double *yt, const doubl
     p2p(nt, xt, yt, zt, ns, xs, ys, zs, qs, sx, sy, sz, pot, ex, ey, ez, r2_min);
     return;
   }
-  p2p_dipoles_path_for(default_simd_path())(nt, xt, yt, zt, ns, xs, ys, zs, qs, pxs, pys, pzs, sx, sy, sz, pot, ex,
-                                            ey, ez, g6, r2_min, charges, dipoles);
+  using Kernel = void (*)(std::size_t, const double *, const double *, const double *, std::size_t, const double *,
+                         const double *, const double *, const double *, const double *, const double *,
+                         const double *, double, double, double, double *, double *, double *, double *, double *,
+                         double, bool, bool);
+  static const Kernel kernel = [] {
+#if GCFMM_X86_DISPATCH
+    const SimdPath p = default_simd_path();
+    if (p == SimdPath::AVX512) return static_cast<Kernel>(p2p_dipoles_avx512);
+    if (p == SimdPath::AVX2) return static_cast<Kernel>(p2p_dipoles_avx2);
+#endif
+    return static_cast<Kernel>(p2p_dipoles_generic);
+  }();
+  kernel(nt, xt, yt, zt, ns, xs, ys, zs, qs, pxs, pys, pzs, sx, sy, sz, pot, ex, ey, ez, g6, r2_min, charges, dipoles);
 }
 
 }  // namespace gcfmm

@@ -58,7 +58,8 @@ void PolarizableSolver::evaluate(const double *p, bool charges, bool gradient) {
     src.pz = spz_.data();
   }
   g_.resize(gradient ? 6 * ns : 0);
-  solver_.evaluate_dipoles(src, {pot_.data(), ex_.data(), ey_.data(), ez_.data(), gradient ? g_.data() : nullptr});
+  // the images are sources only
+  solver_.evaluate_dipoles(src, {pot_.data(), ex_.data(), ey_.data(), ez_.data(), gradient ? g_.data() : nullptr, n_});
 }
 
 void PolarizableSolver::compute(std::size_t n, const double *x, const double *y, const double *z, const double *q,

@@ -24,6 +24,20 @@ bool SolverCore::sort_dipoles(const DipoleSources &src) {
   return any;
 }
 
+void SolverCore::mark_targets(std::size_t targets) {
+  node_has_target.clear();
+  if (targets >= n) return;
+  const auto &nodes = tree.nodes;
+  node_has_target.assign(nodes.size(), 0);
+  // children have larger indices than their parents: leaves first, then up
+  for (std::size_t i = nodes.size(); i-- > 0;) {
+    const Node &A = nodes[i];
+    if (A.leaf())
+      for (std::uint32_t k = A.begin; k < A.end && !node_has_target[i]; ++k) node_has_target[i] = tree.perm[k] < targets;
+    if (node_has_target[i] && A.parent >= 0) node_has_target[A.parent] = 1;
+  }
+}
+
 bool SolverCore::source_coincident_pair(std::size_t &i, std::size_t &j) const {
   const auto &perm = tree.perm;
   auto source = [&](std::size_t k) {
@@ -91,11 +105,19 @@ void SolverCore::far_field_dipoles(const TargetRange &t, bool gradient) {
 // back from the length unit h: pot ~ 1/length, E ~ 1/length^2, G ~ 1/length^3
 void SolverCore::scatter_dipoles(const TargetRange &t, const FieldOutputs &out) const {
   scatter(t, out.pot, out.ex, out.ey, out.ez);
+  // the results of particles that are not targets are partial: zero them
+  if (out.targets < n)
+    for (std::size_t k = t.begin; k < t.end; ++k)
+      if (tree.perm[k] >= out.targets) {
+        const std::size_t i = tree.perm[k];
+        out.pot[i] = out.ex[i] = out.ey[i] = out.ez[i] = 0.0;
+      }
   if (!out.gradient) return;
   const double fg = inv_h * inv_h * inv_h;
   for (std::size_t k = t.begin; k < t.end; ++k) {
     double *g = out.gradient + 6 * tree.perm[k];
-    for (int c = 0; c < 6; ++c) g[c] = fg * sorted_g[6 * k + c];
+    const double f = tree.perm[k] < out.targets ? fg : 0.0;
+    for (int c = 0; c < 6; ++c) g[c] = f * sorted_g[6 * k + c];
   }
 }
 
@@ -121,6 +143,7 @@ void gcfmm::Solver::evaluate_dipoles(const DipoleSources &src, const FieldOutput
                                 std::to_string(I.res.order));
   I.evaluated = false;
   I.sort_dipoles(src);
+  I.mark_targets(out.targets);
   std::size_t first, second;
   if (I.source_coincident_pair(first, second)) throw coincidence_error(first, second, I.h);
   const bool gradient = out.gradient != nullptr;

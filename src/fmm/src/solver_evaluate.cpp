@@ -7,6 +7,7 @@ namespace gcfmm {
 using namespace detail;
 
 void SolverCore::sort_charges(const double *q) {
+  node_has_target.clear();  // evaluate(): every particle is a target
   const auto &perm = tree.perm;
   for (std::size_t k = 0; k < n; ++k) sorted_q[k] = q[perm[k]];
 }

@@ -236,6 +236,8 @@ struct SolverCore {
   std::vector<double> sorted_average_pot;     // the average far field's part of sorted_pot
   // evaluate_dipoles(): dipoles (units of h) and field gradients (6 per particle), tree order
   std::vector<double> sorted_px, sorted_py, sorted_pz, sorted_g;
+  // evaluate_dipoles() with FieldOutputs::targets: nodes holding a target (empty: all nodes)
+  std::vector<char> node_has_target;
   bool evaluated = false;                     // evaluate() ran since the last build()
   detail::TargetRange last_range;                     // targets of the last evaluate()
   std::vector<const double *> batch_m;        // M2L batch of one target node: source multipoles
@@ -300,8 +302,9 @@ struct SolverCore {
   // f(i, node) for every node i that holds targets of the range, in node order
   template <class F>
   void for_target_nodes(const detail::TargetRange &t, F &&f) {
+    const bool all = node_has_target.empty();
     for (std::size_t i = 0; i < tree.nodes.size(); ++i)
-      if (t.hits(tree.nodes[i])) f(i, tree.nodes[i]);
+      if (t.hits(tree.nodes[i]) && (all || node_has_target[i])) f(i, tree.nodes[i]);
   }
   void sort_charges(const double *q);
   // the first coincident pair with a charge, as input indices i < j; false if none
@@ -321,6 +324,8 @@ struct SolverCore {
   // ---- evaluate_dipoles() phases (solver_dipoles.cpp) ----
   // charges and dipoles to tree order (zero where not given); true if any dipole is nonzero
   bool sort_dipoles(const DipoleSources &src);
+  // node_has_target for the particles with input index < targets (cleared if that is all)
+  void mark_targets(std::size_t targets);
   // the first coincident pair with a charge or a dipole, as input indices i < j; false if none
   bool source_coincident_pair(std::size_t &i, std::size_t &j) const;
   void p2p_dipoles(const detail::TargetRange &t, bool gradient);

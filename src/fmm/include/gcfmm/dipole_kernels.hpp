@@ -36,62 +36,87 @@ struct PointField {
   SymTensor g;
 };
 
-/** @brief Add the potential and field (not the gradient) of a charge q at a target displaced by
- *  d = target - source (d != 0); returns 1 / r^2 for add_charge(). */
-inline double add_charge_field(double q, const Vec3 &d, double &pot, Vec3 &e)
+//! Potential, field and field gradient accumulated in any arithmetic type T (double, or a
+//! SIMD register type with GCC's vector operators: the P2P kernels of src/kernels.cpp).
+template <class T>
+struct FieldTerms {
+  T pot{}, ex{}, ey{}, ez{}, gxx{}, gxy{}, gxz{}, gyy{}, gyz{}, gzz{};
+};
+
+/** @brief The terms of a charge q at a target displaced by d = target - source, given
+ *  rinv = 1 / |d| (rinv = 0 adds nothing: the kernels' way of dropping a pair). The gradient
+ *  only with kGradient. */
+template <bool kGradient, class T>
+inline void charge_terms(T q, T dx, T dy, T dz, T rinv, FieldTerms<T> &f)
 {
-  const double r2 = norm2(d), rinv = 1.0 / std::sqrt(r2), rinv2 = rinv * rinv;
-  const double q3 = q * rinv * rinv2;
-  pot += q * rinv;
-  e.x += q3 * d.x;
-  e.y += q3 * d.y;
-  e.z += q3 * d.z;
-  return rinv2;
+  const T rinv2 = rinv * rinv, q3 = q * rinv * rinv2;
+  f.pot += q * rinv;
+  f.ex += q3 * dx;
+  f.ey += q3 * dy;
+  f.ez += q3 * dz;
+  if (kGradient) {
+    const T q5 = 3.0 * q3 * rinv2;
+    f.gxx += q3 - q5 * dx * dx;
+    f.gyy += q3 - q5 * dy * dy;
+    f.gzz += q3 - q5 * dz * dz;
+    f.gxy -= q5 * dx * dy;
+    f.gxz -= q5 * dx * dz;
+    f.gyz -= q5 * dy * dz;
+  }
+}
+
+/** @brief The terms of a point dipole p at a target displaced by d, given rinv = 1 / |d|
+ *  (0: nothing). */
+template <bool kGradient, class T>
+inline void dipole_terms(T px, T py, T pz, T dx, T dy, T dz, T rinv, FieldTerms<T> &f)
+{
+  const T rinv2 = rinv * rinv, r3 = rinv * rinv2, r5 = r3 * rinv2;
+  const T pd = px * dx + py * dy + pz * dz;
+  f.pot += pd * r3;
+  const T a = 3.0 * pd * r5;
+  f.ex += a * dx - px * r3;
+  f.ey += a * dy - py * r3;
+  f.ez += a * dz - pz * r3;
+  if (kGradient) {
+    const T b = 3.0 * r5, c = 15.0 * pd * r5 * rinv2;
+    f.gxx += b * (2.0 * px * dx + pd) - c * dx * dx;
+    f.gyy += b * (2.0 * py * dy + pd) - c * dy * dy;
+    f.gzz += b * (2.0 * pz * dz + pd) - c * dz * dz;
+    f.gxy += b * (px * dy + py * dx) - c * dx * dy;
+    f.gxz += b * (px * dz + pz * dx) - c * dx * dz;
+    f.gyz += b * (py * dz + pz * dy) - c * dy * dz;
+  }
+}
+
+//! FieldTerms<double> added to a PointField
+inline void add_terms(const FieldTerms<double> &t, PointField &f)
+{
+  f.pot += t.pot;
+  f.e = f.e + Vec3{t.ex, t.ey, t.ez};
+  f.g.xx += t.gxx;
+  f.g.xy += t.gxy;
+  f.g.xz += t.gxz;
+  f.g.yy += t.gyy;
+  f.g.yz += t.gyz;
+  f.g.zz += t.gzz;
 }
 
 /** @brief Add the potential, field and field gradient of a charge q at a target displaced by
  *  d = target - source (d != 0). */
 inline void add_charge(double q, const Vec3 &d, PointField &f)
 {
-  const double rinv2 = add_charge_field(q, d, f.pot, f.e);
-  const double q3 = q * rinv2 * std::sqrt(rinv2), q5 = 3.0 * q3 * rinv2;
-  f.g.xx += q3 - q5 * d.x * d.x;
-  f.g.yy += q3 - q5 * d.y * d.y;
-  f.g.zz += q3 - q5 * d.z * d.z;
-  f.g.xy -= q5 * d.x * d.y;
-  f.g.xz -= q5 * d.x * d.z;
-  f.g.yz -= q5 * d.y * d.z;
-}
-
-/** @brief Add the potential and field (not the gradient) of a point dipole p at a target
- *  displaced by d = target - source (d != 0); returns 1 / r^2 for add_dipole(). */
-inline double add_dipole_field(const Vec3 &p, const Vec3 &d, double &pot, Vec3 &e)
-{
-  const double r2 = norm2(d), rinv = 1.0 / std::sqrt(r2), rinv2 = rinv * rinv;
-  const double r3 = rinv * rinv2, r5 = r3 * rinv2;
-  const double pd = dot(p, d);
-  pot += pd * r3;
-  const double a = 3.0 * pd * r5;
-  e.x += a * d.x - p.x * r3;
-  e.y += a * d.y - p.y * r3;
-  e.z += a * d.z - p.z * r3;
-  return rinv2;
+  FieldTerms<double> t;
+  charge_terms<true>(q, d.x, d.y, d.z, 1.0 / std::sqrt(norm2(d)), t);
+  add_terms(t, f);
 }
 
 /** @brief Add the potential, field and field gradient of a point dipole p at a target
  *  displaced by d = target - source (d != 0). */
 inline void add_dipole(const Vec3 &p, const Vec3 &d, PointField &f)
 {
-  const double rinv2 = add_dipole_field(p, d, f.pot, f.e);
-  const double r5 = rinv2 * rinv2 * std::sqrt(rinv2), r7 = r5 * rinv2;
-  const double pd = dot(p, d);
-  const double b = 3.0 * r5, c = 15.0 * pd * r7;
-  f.g.xx += b * (2.0 * p.x * d.x + pd) - c * d.x * d.x;
-  f.g.yy += b * (2.0 * p.y * d.y + pd) - c * d.y * d.y;
-  f.g.zz += b * (2.0 * p.z * d.z + pd) - c * d.z * d.z;
-  f.g.xy += b * (p.x * d.y + p.y * d.x) - c * d.x * d.y;
-  f.g.xz += b * (p.x * d.z + p.z * d.x) - c * d.x * d.z;
-  f.g.yz += b * (p.y * d.z + p.z * d.y) - c * d.y * d.z;
+  FieldTerms<double> t;
+  dipole_terms<true>(p.x, p.y, p.z, d.x, d.y, d.z, 1.0 / std::sqrt(norm2(d)), t);
+  add_terms(t, f);
 }
 
 //! Force F = q E + G p on a particle with charge q and dipole p in the field f.

@@ -72,6 +72,10 @@ struct FieldOutputs {
   double *ey = nullptr;
   double *ez = nullptr;
   double *gradient = nullptr;  //!< 6 per particle, G_ab = dE_a/dx_b as xx, xy, xz, yy, yz, zz; null: not computed
+  /// only the particles with index < targets are targets (the others are sources only, e.g.
+  /// the images of an electrode: their results are left 0 or partial, and their nodes skip
+  /// M2L, L2L, L2P and P2P); the default: all
+  std::size_t targets = static_cast<std::size_t>(-1);
 };
 
 /** Adaptive FMM solver. Usage: Solver s(opts); s.set_box(...) (periodic); s.build(n, x, y, z);
