@@ -91,13 +91,12 @@ PolarizableResult solve_polarizable_direct(const PolarizableSystem &s,
     const Vec3 pi{p[3 * i], p[3 * i + 1], p[3 * i + 2]};
     const Vec3 ri{s.x[i], s.y[i], s.z[i]};
     PointField f = field_at(s, i, s.alpha ? p.data() : nullptr, {true, true});
+    res.energy += polarizable_energy_term(s.q[i], f.pot, s.applied_field, ri - origin, pi);
     f.e = f.e + s.applied_field;
     f.pot -= dot(s.applied_field, ri - origin);
     res.dipole[i] = pi;
     res.field[i] = f;
     res.force[i] = point_force(s.q[i], pi, f);
-    const Vec3 e0i{e0[3 * i], e0[3 * i + 1], e0[3 * i + 2]};
-    res.energy += polarizable_energy_term(s.q[i], f0[i].pot, s.applied_field, ri - origin, pi, e0i);
   }
   return res;
 }

@@ -87,18 +87,20 @@ void PolarizableSolver::compute(std::size_t n, const double *x, const double *y,
   }
   solver_.build(ns, sx_.data(), sy_.data(), sz_.data());
 
-  // E0: the charges (and their images) and the applied field
-  evaluate(nullptr, true, false);
   const Vec3 &ea = env_.applied_field;
-  std::vector<double> e0(3 * n), phi_q(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    e0[3 * i] = ex_[i] + ea.x;
-    e0[3 * i + 1] = ey_[i] + ea.y;
-    e0[3 * i + 2] = ez_[i] + ea.z;
-    phi_q[i] = pot_[i];
-  }
   report_ = PolarizationReport{};
+  if (!alpha)
+    for (std::size_t k = 0; k < 3 * n; ++k) p[k] = 0.0;
+  // one evaluation of the charges and the starting dipoles: the local field E0 + T p of the
+  // induction's start (no evaluation of E0 apart)
   if (alpha) {
+    evaluate(p, true, false);
+    std::vector<double> local(3 * n);
+    for (std::size_t i = 0; i < n; ++i) {
+      local[3 * i] = ex_[i] + ea.x;
+      local[3 * i + 1] = ey_[i] + ea.y;
+      local[3 * i + 2] = ez_[i] + ea.z;
+    }
     const DipoleFieldOperator field = [&](const double *pv, double *f) {
       evaluate(pv, false, false);
       for (std::size_t i = 0; i < n; ++i) {
@@ -107,14 +109,14 @@ void PolarizableSolver::compute(std::size_t n, const double *x, const double *y,
         f[3 * i + 2] = ez_[i];
       }
     };
-    report_ = solve_induced_dipoles(n, alpha, e0.data(), field, p, induction_);
+    report_ = solve_induced_dipoles_from(n, alpha, local.data(), field, p, induction_);
+    report_.iterations += 1;  // the first evaluation
   } else {
-    for (std::size_t k = 0; k < 3 * n; ++k) p[k] = 0.0;
     report_.converged = true;
   }
-
-  // the total field and its gradient with the converged dipoles
+  // the field and its gradient with the converged dipoles
   evaluate(alpha ? p : nullptr, true, true);
+
   out.field.assign(3 * n, 0.0);
   out.force.assign(3 * n, 0.0);
   out.energy.assign(n, 0.0);
@@ -134,8 +136,7 @@ void PolarizableSolver::compute(std::size_t n, const double *x, const double *y,
     Fi[0] = force.x;
     Fi[1] = force.y;
     Fi[2] = force.z;
-    const Vec3 e0i{e0[3 * i], e0[3 * i + 1], e0[3 * i + 2]};
-    out.energy[i] = polarizable_energy_term(q[i], phi_q[i], ea, Vec3{x[i], y[i], z[i]} - origin, pi, e0i);
+    out.energy[i] = polarizable_energy_term(q[i], pot_[i], ea, Vec3{x[i], y[i], z[i]} - origin, pi);
     energy_ += out.energy[i];
   }
 }

@@ -19,9 +19,10 @@ double dot(const std::vector<double> &a, const std::vector<double> &b)
 
 }  // namespace
 
-PolarizationReport solve_induced_dipoles(std::size_t n, const double *alpha, const double *e0,
-                                         const DipoleFieldOperator &field, double *p,
-                                         const PolarizationSettings &settings)
+namespace {
+
+// the sign of the nonzero alpha (0 if none); throws on mixed signs or non-finite values
+double polarizability_sign(std::size_t n, const double *alpha)
 {
   // A = sign (alpha^-1 - T) is symmetric positive definite when every alpha has the sign
   // `sign` and the packing is below the polarization catastrophe (2 |alpha| / d^3 < 1 for a
@@ -38,18 +39,54 @@ PolarizationReport solve_induced_dipoles(std::size_t n, const double *alpha, con
       throw std::invalid_argument("gcfmm: polarizabilities of both signs (eps_p above and below "
                                   "eps_m) cannot be solved together");
   }
+  return sign;
+}
+
+}  // namespace
+
+PolarizationReport solve_induced_dipoles(std::size_t n, const double *alpha, const double *e0,
+                                         const DipoleFieldOperator &field, double *p,
+                                         const PolarizationSettings &settings)
+{
+  polarizability_sign(n, alpha);  // the checks before any work
+  const std::size_t m = 3 * n;
+  std::vector<double> local(m, 0.0), x(m);
+  bool warm = false;
+  for (std::size_t k = 0; k < m; ++k) {
+    x[k] = alpha[k / 3] == 0.0 ? 0.0 : p[k];
+    warm = warm || x[k] != 0.0;
+  }
+  if (warm) field(x.data(), local.data());
+  for (std::size_t k = 0; k < m; ++k) local[k] += e0[k];
+  PolarizationReport rep = solve_induced_dipoles_from(n, alpha, local.data(), field, x.data(), settings);
+  rep.iterations += warm ? 1 : 0;
+  for (std::size_t k = 0; k < m; ++k) p[k] = x[k];
+  return rep;
+}
+
+PolarizationReport solve_induced_dipoles_from(std::size_t n, const double *alpha, const double *local,
+                                              const DipoleFieldOperator &field, double *p,
+                                              const PolarizationSettings &settings)
+{
+  const double sign = polarizability_sign(n, alpha);
   const std::size_t m = 3 * n;
   PolarizationReport rep;
-  std::vector<double> b(m, 0.0), x(m), r(m), z(m), d(m), ad(m), tmp(m);
+  std::vector<double> x(m), r(m), z(m), d(m), ad(m), tmp(m);
+  // r = b - A x = sign (E0 + T x - x / alpha): the local field of the start gives it directly
+  double bnorm = 0.0;
   for (std::size_t k = 0; k < m; ++k) {
     const double a = alpha[k / 3];
-    b[k] = a == 0.0 ? 0.0 : sign * e0[k];
     x[k] = a == 0.0 ? 0.0 : p[k];
+    r[k] = a == 0.0 ? 0.0 : sign * (local[k] - x[k] / a);
+    z[k] = std::fabs(a) * r[k];
+    bnorm += a * a * local[k] * local[k];
   }
-  // the residual measure: || alpha r || / || alpha E0 ||, r = b - A x (preconditioned residual)
-  double bnorm = 0.0;
-  for (std::size_t k = 0; k < m; ++k) bnorm += alpha[k / 3] * alpha[k / 3] * b[k] * b[k];
   bnorm = std::sqrt(bnorm);
+  if (bnorm == 0.0) {
+    for (std::size_t k = 0; k < m; ++k) p[k] = 0.0;
+    rep.converged = true;
+    return rep;
+  }
   auto apply = [&](const std::vector<double> &v, std::vector<double> &out) {
     field(v.data(), tmp.data());
     ++rep.iterations;
@@ -58,16 +95,7 @@ PolarizationReport solve_induced_dipoles(std::size_t n, const double *alpha, con
       out[k] = a == 0.0 ? 0.0 : sign * (v[k] / a - tmp[k]);
     }
   };
-  if (bnorm == 0.0) {
-    for (std::size_t k = 0; k < m; ++k) p[k] = 0.0;
-    rep.converged = true;
-    return rep;
-  }
-  apply(x, ad);
-  for (std::size_t k = 0; k < m; ++k) {
-    r[k] = b[k] - ad[k];
-    z[k] = std::fabs(alpha[k / 3]) * r[k];
-  }
+  // the residual measure: || alpha r || / || alpha (E0 + T x_start) || (preconditioned residual)
   auto residual = [&]() { return std::sqrt(dot(z, z)) / bnorm; };
   rep.residual = residual();
   d = z;

@@ -127,16 +127,16 @@ inline Vec3 point_force(double q, const Vec3 &p, const PointField &f)
 }
 
 /** @brief Particle i's term of the electrostatic energy of charges, induced dipoles and a
- *  uniform applied field (doc/polarization.md, eq. (3.4)):
- *  U_i = 1/2 q phi_q - q E_a . (r - r_0) - 1/2 p . E0, with phi_q the potential of the
- *  (other) charges and their images at the particle, E_a the applied field, r_0 the point of
- *  zero applied potential and E0 the field of the charges and the applied field. Summed over
- *  the particles it is the energy whose gradient is minus the forces q E + G p, once p solves
- *  (3.3). */
-inline double polarizable_energy_term(double q, double phi_q, const Vec3 &applied, const Vec3 &r_minus_r0,
-                                      const Vec3 &p, const Vec3 &e0)
+ *  uniform applied field (doc/polarization.md, eqs. (3.4)-(3.5)):
+ *  U_i = 1/2 q phi - q E_a . (r - r_0) - 1/2 p . E_a, with phi the potential of the charges
+ *  and dipoles (and their images) at the particle, E_a the applied field and r_0 the point of
+ *  zero applied potential. Summed over the particles it is U = 1/2 sum q phi_q - sum q E_a . r
+ *  - 1/2 sum p . E0 (3.4) by reciprocity (sum q phi_p = -sum p . E_q), the energy whose
+ *  gradient is minus the forces q E + G p once p solves (3.3). */
+inline double polarizable_energy_term(double q, double phi, const Vec3 &applied, const Vec3 &r_minus_r0,
+                                      const Vec3 &p)
 {
-  return 0.5 * q * phi_q - q * dot(applied, r_minus_r0) - 0.5 * dot(p, e0);
+  return 0.5 * q * phi - q * dot(applied, r_minus_r0) - 0.5 * dot(p, applied);
 }
 
 // ---- a grounded conducting plane z = z0 (doc/polarization.md, section 2) ---------------------

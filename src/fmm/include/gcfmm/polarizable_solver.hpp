@@ -49,7 +49,9 @@ class PolarizableSolver {
 
   /** @brief Dipoles, fields, forces and energy of n particles with charges q and
    *  polarizabilities alpha (null: none, p = 0). p (3 n): in, the starting dipoles (warm
-   *  start); out, the solution.
+   *  start); out, the solution. Evaluations: one of the charges and the starting dipoles,
+   *  one per induction iteration, and a last one with the field gradient;
+   *  report().iterations counts them all but the last.
    *  @throws std::invalid_argument if a particle is at or below the electrode, or as
    *  solve_induced_dipoles(); CoincidentParticles as Solver::evaluate_dipoles. */
   void compute(std::size_t n, const double *x, const double *y, const double *z, const double *q,

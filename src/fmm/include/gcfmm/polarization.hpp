@@ -41,6 +41,15 @@ PolarizationReport solve_induced_dipoles(std::size_t n, const double *alpha, con
                                          const DipoleFieldOperator &field, double *p,
                                          const PolarizationSettings &settings);
 
+/** @brief The same iteration started from the local field E0 + T p of the starting dipoles p
+ *  (3 n), e.g. from one evaluation of the charges and the starting dipoles together, which
+ *  saves an evaluation: E0 is not needed apart. The residual is measured against
+ *  || alpha (E0 + T p_start) || (against || alpha E0 || for a cold start, p = 0). The operator
+ *  applications counted in the report exclude the one that gave `local`. */
+PolarizationReport solve_induced_dipoles_from(std::size_t n, const double *alpha, const double *local,
+                                              const DipoleFieldOperator &field, double *p,
+                                              const PolarizationSettings &settings);
+
 }  // namespace gcfmm
 
 #endif
