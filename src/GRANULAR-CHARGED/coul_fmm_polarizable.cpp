@@ -47,6 +47,12 @@ void CoulFMMPolarizable::init(const gcfmm::Options &opts)
                "Fix coul/fmm polarize: medium permittivity {:g} differs from the dielectric "
                "command's {:g}, which scales every Coulomb force; set dielectric {:g}",
                s.eps_medium, force->dielectric, s.eps_medium);
+  // a conductor has no tangential field at its surface: the applied field must be normal
+  if (s.electrode && s.efield && (s.field[0] != 0.0 || s.field[1] != 0.0))
+    error->all(FLERR,
+               "Fix coul/fmm efield {:g} {:g} {:g} with electrode: a grounded plane allows only a "
+               "field normal to it (efield 0 0 Ez)",
+               s.field[0], s.field[1], s.field[2]);
   if (s.electrode && s.electrode_z >= domain->boxhi[2])
     error->all(FLERR, "Fix coul/fmm electrode {:g} is not below the box top {:g}", s.electrode_z,
                domain->boxhi[2]);
@@ -182,6 +188,23 @@ double CoulFMMPolarizable::evaluate(double **field, double **force_out)
     energy += c * out.energy[k];
   }
   return energy;
+}
+
+double CoulFMMPolarizable::estimated_error() const
+{
+  return solver ? solver->stats().estimated_error : 0.0;
+}
+int CoulFMMPolarizable::order() const
+{
+  return solver ? solver->stats().order : 0;
+}
+double CoulFMMPolarizable::m2l() const
+{
+  return solver ? (double) solver->stats().m2l_count : 0.0;
+}
+double CoulFMMPolarizable::p2p() const
+{
+  return solver ? (double) solver->stats().p2p_pairs : 0.0;
 }
 
 double CoulFMMPolarizable::memory_usage() const

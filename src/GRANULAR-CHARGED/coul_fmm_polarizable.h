@@ -53,6 +53,11 @@ class CoulFMMPolarizable : protected Pointers {
   // LAMMPS units, zero outside the group; returns this rank's part of the energy
   double evaluate(double **field, double **force);
 
+  // the solver's error estimate, order, M2L and P2P counts of the last evaluation
+  double estimated_error() const;
+  int order() const;
+  double m2l() const;
+  double p2p() const;
   int iterations() const { return last_iterations; }
   double residual() const { return last_residual; }
   const Settings &settings() const { return s; }

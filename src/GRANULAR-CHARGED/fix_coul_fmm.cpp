@@ -468,10 +468,11 @@ double FixCoulFMM::compute_scalar()
 double FixCoulFMM::compute_vector(int n)
 {
   const auto &d = evaluator->diagnostics_of_last();
-  const double values[14] = {d.estimated_error,
-                             (double) d.order,
-                             d.m2l,
-                             d.p2p,
+  const bool pol = polarizable != nullptr;
+  const double values[14] = {pol ? polarizable->estimated_error() : d.estimated_error,
+                             pol ? (double) polarizable->order() : (double) d.order,
+                             pol ? polarizable->m2l() : d.m2l,
+                             pol ? polarizable->p2p() : d.p2p,
                              stepping->check_last(),
                              stepping->check_max(),
                              stepping->check_overall(),

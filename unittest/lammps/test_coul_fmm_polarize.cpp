@@ -137,13 +137,13 @@ TEST(CoulFMMPolarize, ForceIsMinusEnergyGradient)
     moved[atom][dim] += dx;
     Lmp l;
     spheres(l, "p p f", moved, 9.0);
-    l.cmds({"fix fmm all coul/fmm accuracy 1e-10 polarize 3.8 efield 0.05 0.02 0.4 electrode 0.5",
+    l.cmds({"fix fmm all coul/fmm accuracy 1e-10 polarize 3.8 efield 0 0 0.4 electrode 0.5",
             "fix_modify fmm energy yes", "run 0 post no"});
     return l.var("f_fmm");
   };
   Lmp l;
   spheres(l, "p p f", atoms, 9.0);
-  l.cmds({"fix fmm all coul/fmm accuracy 1e-10 polarize 3.8 efield 0.05 0.02 0.4 electrode 0.5",
+  l.cmds({"fix fmm all coul/fmm accuracy 1e-10 polarize 3.8 efield 0 0 0.4 electrode 0.5",
           "fix_modify fmm energy yes", "run 0 post no"});
   const auto f = gather(l, "f", 3);
   const double h = 1e-4;
@@ -236,6 +236,7 @@ TEST(CoulFMMPolarize, BadInput)
   expect_match(with(sph, "fix fmm all coul/fmm electrode 6"), "atom 1 \\(z = 5\\) is not above the electrode \\(z = 6\\)");
   expect_match(with(sph, "fix fmm all coul/fmm efield 0 0"), "Illegal fix coul/fmm efield command: missing argument");
   expect_match(with(sph, "fix fmm all coul/fmm induction 1e-6"), "induction needs polarize");
+  expect_match(with(sph, "fix fmm all coul/fmm efield 1 0 1 electrode 0"), "allows only a field normal to it");
   expect_match(with(sph, "fix fmm all coul/fmm polarize 4 solver distributed"), "need solver replicated");
   expect_match(with(sph, "fix fmm all coul/fmm polarize 4 farfield average"), "need farfield exact or none");
   expect_match(with(sph, "fix fmm all coul/fmm efield 0 0 1", "5", "fix ef all efield 0 0 1"), "would both apply the field");
