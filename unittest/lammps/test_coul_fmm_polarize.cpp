@@ -212,6 +212,86 @@ TEST(CoulFMMPolarize, OneVersusTwoRanks)
   EXPECT_LT(rel_rms(two, one), 1e-12);
 }
 
+// a periodic layer of charges above the electrode against LAMMPS's own Ewald with the slab
+// correction on the system with its images made explicit (atoms of charge -q at the mirror
+// points; the pair is neutral): the force on the real atoms is the same sum
+TEST(CoulFMMPolarize, ElectrodeVsEwaldWithExplicitImages)
+{
+  const auto atoms = random_spheres(27, 21, 9.0);
+  const double z0 = 0.5;
+  auto ewald = [&](double slab) {
+    Lmp l;
+    l.cmds({"units real", "atom_style charge", "atom_modify map array sort 0 0", "boundary p p f",
+            "region box block 0 9 0 9 -12 12", "create_box 2 box", "mass * 1.0"});
+    for (size_t k = 0; k < atoms.size(); k++)
+      l.cmds({fmt::format("create_atoms 1 single {} {} {} units box", atoms[k][0], atoms[k][1], atoms[k][2]),
+              fmt::format("set atom {} charge {}", k + 1, atoms[k][3])});
+    for (size_t k = 0; k < atoms.size(); k++)
+      l.cmds({fmt::format("create_atoms 2 single {} {} {} units box", atoms[k][0], atoms[k][1], 2 * z0 - atoms[k][2]),
+              fmt::format("set atom {} charge {}", atoms.size() + k + 1, -atoms[k][3])});
+    l.cmds({"pair_style coul/long 8.0", "pair_coeff * *", "kspace_style ewald 1e-12",
+            fmt::format("kspace_modify slab {}", slab), "run 0 post no"});
+    auto f = gather(l, "f", 3);
+    f.resize(3 * atoms.size());    // the real atoms
+    return f;
+  };
+  const auto f3 = ewald(3.0), f6 = ewald(6.0);
+  const double conv = rel_rms(f3, f6);
+  EXPECT_LT(conv, 1e-7) << "the slab reference must be converged in its volume factor";
+  for (const double acc : {1e-4, 1e-6}) {
+    Lmp l;
+    spheres(l, "p p f", atoms, 9.0);
+    l.cmds({fmt::format("fix fmm all coul/fmm accuracy {} electrode {}", acc, z0), "run 0 post no"});
+    const double err = rel_rms(gather(l, "f", 3), f6);
+    std::printf("[ electrode vs ewald + explicit images ] accuracy %g: %.3g (slab 3 vs 6: %.2g)\n", acc, err, conv);
+    EXPECT_LT(err, acc);
+  }
+}
+
+// a periodic layer of uncharged dielectric spheres polarised by the field: the forces at the
+// converged dipoles against LAMMPS's dipole Ewald with the slab correction (KSPACE ewald/dipole,
+// DIPOLE lj/cut/dipole/long without LJ) on the same dipoles; the applied field is uniform and
+// exerts no force, so both are the dipole-dipole forces (p . grad) E
+TEST(CoulFMMPolarize, InducedDipolesVsDipoleEwald)
+{
+  auto atoms = random_spheres(27, 23, 9.0);
+  for (auto &a : atoms) a[3] = 0.0;
+  const size_t n = atoms.size();
+  for (const double acc : {1e-4, 1e-6}) {
+    Lmp l;
+    spheres(l, "p p f", atoms, 9.0);
+    l.cmds({fmt::format("fix fmm all coul/fmm accuracy {} polarize 20.0 efield 0.3 0.1 2.0", acc),
+            "run 0 post no"});
+    const auto f = gather(l, "f", 3);
+    std::vector<double> col(7 * n);
+    lammps_gather(l.lmp, (char *) "f_fmm", 1, 7, col.data());
+    auto ewald = [&](double slab) {
+      Lmp r;
+      r.cmds({"units real", "atom_style hybrid sphere dipole", "atom_modify map array sort 0 0",
+              "boundary p p f", "region box block 0 9 0 9 0 30", "create_box 1 box"});
+      for (size_t k = 0; k < n; k++)
+        r.cmds({fmt::format("create_atoms 1 single {} {} {} units box", atoms[k][0], atoms[k][1], atoms[k][2]),
+                fmt::format("set atom {} dipole {:.17g} {:.17g} {:.17g}", k + 1, col[7 * k + 4], col[7 * k + 5],
+                            col[7 * k + 6])});
+      r.cmds({"set group all diameter 2.0 density 1.0", "pair_style lj/cut/dipole/long 1.0 8.0",
+              "pair_coeff * * 0.0 1.0", "kspace_style ewald/dipole 1e-12",
+              // ewald/dipole's own choice of g_ewald and k-vectors from its accuracy is not
+              // converged here (forces moved by O(1) between slab 3 and 6 and between
+              // accuracies 1e-6 and 1e-10): both are set so that real space (erfc(0.6 x 8) ~
+              // 1e-11) and k space (kmax 16 per 9 A, 100 per 90 A of slab) converge
+              fmt::format("kspace_modify slab {} gewald 0.6 kmax/ewald 16 16 {}", slab, int(100 * slab / 3)),
+              "run 0 post no"});
+      return gather(r, "f", 3);
+    };
+    const auto f3 = ewald(3.0), f6 = ewald(6.0);
+    const double conv = rel_rms(f3, f6), err = rel_rms(f, f6);
+    std::printf("[ induced dipoles vs ewald/dipole + slab ] accuracy %g: %.3g (slab 3 vs 6: %.2g)\n", acc, err,
+                conv);
+    EXPECT_LT(conv, 1e-7);
+    EXPECT_LT(err, acc);
+  }
+}
+
 TEST(CoulFMMPolarize, BadInput)
 {
   auto with = [](const std::string &style, const std::string &fix, const std::string &z = "5",
