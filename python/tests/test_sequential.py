@@ -77,3 +77,27 @@ def test_plane_rain_start_plane_follows_the_resting_bed(cli, tmp_path):
     header = re.findall(r"^\s*(Step .*c_ztop.*)$", log, re.M)[-1].split()
     ztop = float(blocks[-1].strip().splitlines()[-1].split()[header.index("c_ztop")])
     assert max(starts) <= ztop + 7.5 * rp, (max(starts) / rp, ztop / rp)
+
+
+def test_plane_without_a_free_place_ends_with_a_warning(cli, tmp_path):
+    """A start plane too crowded for the next particle (earlier ones still in it: in a 3 r_p
+    box no two particles fit side by side within 2 r_p, and with an interval of 0.3 r_p of
+    fall the last one is still there) ends the deposition with a warning and a result, as at
+    the levitation limit, instead of failing (seen at paper size: 120 e_0, 1 um, after 1816
+    particles, where the particles hovered at the plane)."""
+    res, log = _run(cli, tmp_path, 0, size=["--N", 6, "--seed", 1, "--var", "L_rp", 3, "--var", "H_rp", 30,
+                                            "--var", "inject", "plane", "--var", "seq_gap_rp", 0.3,
+                                            "--no-render"])
+    assert "finds no free place in the start plane" in log
+    assert 1 <= res["inserted"] < 6 and res["natoms"] == res["inserted"]
+    assert f"only {res['inserted']} of 6 particles were deposited" in res["warning"]
+
+
+def test_epd_variables_give_fix_coul_fmm_its_keywords(cli, tmp_path):
+    """E0, eps_p and electrode (doc/epd.md) reach fix coul/fmm as efield 0 0 -E0, polarize eps_p
+    and electrode 0.0, its multiple time stepping left out; the deposition runs to the end."""
+    res, log = _run(cli, tmp_path, 400, "--var", "E0", "1e5", "--var", "eps_p", 3.8, "--var", "electrode", "yes",
+                    size=["--N", 4, "--seed", 1, "--var", "L_rp", 6, "--var", "H_rp", 20, "--no-render"])
+    assert re.search(r"^fix coul all coul/fmm accuracy 1e-4 farfield exact images 1 efield 0 0 -100000 "
+                     r"polarize 3.8 electrode 0.0\s*$", log, re.M)
+    assert res["inserted"] == 4 and res["natoms"] == 4 and res["lost"] == 0
