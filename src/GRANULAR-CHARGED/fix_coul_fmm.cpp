@@ -399,26 +399,31 @@ void FixCoulFMM::advance_field()
 // zz term is the virial of the lattice: image shifts have no z component)
 void FixCoulFMM::apply_field()
 {
-  double **x = atom->x, **f = atom->f, *q = atom->q;
+  double *q = atom->q;
   energy_local = 0.0;
   energy_summed = false;
   const bool in_plane = opts->boundary != gcfmm::Boundary::Periodic2D;
   for (int i = 0; i < atom->nlocal; i++) {
     if (!(atom->mask[i] & groupbit) || q[i] == 0.0) continue;
-    const double fx = q[i] * field[i][0], fy = q[i] * field[i][1], fz = q[i] * field[i][2];
-    f[i][0] += fx;
-    f[i][1] += fy;
-    f[i][2] += fz;
+    const double fi[3] = {q[i] * field[i][0], q[i] * field[i][1], q[i] * field[i][2]};
+    add_force(i, fi, in_plane);
     energy_local += 0.5 * q[i] * field[i][3];
-    if (!evflag) continue;
-    double v[6] = {in_plane ? fx * x[i][0] : 0.0,
-                   in_plane ? fy * x[i][1] : 0.0,
-                   fz * x[i][2],
-                   in_plane ? fy * x[i][0] : 0.0,
-                   in_plane ? fz * x[i][0] : 0.0,
-                   in_plane ? fz * x[i][1] : 0.0};
-    v_tally(i, v);
   }
+}
+
+// the force on atom i, and its virial term (with x and y periodic only zz, see apply_field())
+void FixCoulFMM::add_force(int i, const double *fi, bool in_plane)
+{
+  double **x = atom->x, **f = atom->f;
+  for (int k = 0; k < 3; k++) f[i][k] += fi[k];
+  if (!evflag) return;
+  double v[6] = {in_plane ? fi[0] * x[i][0] : 0.0,
+                 in_plane ? fi[1] * x[i][1] : 0.0,
+                 fi[2] * x[i][2],
+                 in_plane ? fi[1] * x[i][0] : 0.0,
+                 in_plane ? fi[2] * x[i][0] : 0.0,
+                 in_plane ? fi[2] * x[i][1] : 0.0};
+  v_tally(i, v);
 }
 
 // efield, polarize, electrode: F_i = q_i E_i + (p_i . grad) E_i and the energy of
@@ -428,23 +433,9 @@ void FixCoulFMM::post_force_polarizable()
   energy_local = polarizable->evaluate(field, polar_force);
   energy_summed = false;
   nevaluations++;
-  double **x = atom->x, **f = atom->f;
   const bool in_plane = opts->boundary != gcfmm::Boundary::Periodic2D;
-  for (int i = 0; i < atom->nlocal; i++) {
-    if (!(atom->mask[i] & groupbit)) continue;
-    const double fx = polar_force[i][0], fy = polar_force[i][1], fz = polar_force[i][2];
-    f[i][0] += fx;
-    f[i][1] += fy;
-    f[i][2] += fz;
-    if (!evflag) continue;
-    double v[6] = {in_plane ? fx * x[i][0] : 0.0,
-                   in_plane ? fy * x[i][1] : 0.0,
-                   fz * x[i][2],
-                   in_plane ? fy * x[i][0] : 0.0,
-                   in_plane ? fz * x[i][0] : 0.0,
-                   in_plane ? fz * x[i][1] : 0.0};
-    v_tally(i, v);
-  }
+  for (int i = 0; i < atom->nlocal; i++)
+    if (atom->mask[i] & groupbit) add_force(i, polar_force[i], in_plane);
   remember_positions();
 }
 

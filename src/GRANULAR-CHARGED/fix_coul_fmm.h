@@ -102,6 +102,7 @@ class FixCoulFMM : public Fix {
   void apply_field();
   void remember_positions();
   void post_force_polarizable();
+  void add_force(int i, const double *fi, bool in_plane);
 };
 
 }    // namespace LAMMPS_NS

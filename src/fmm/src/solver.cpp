@@ -55,9 +55,7 @@ void Solver::evaluate(const double *q, double *pot, double *ex, double *ey, doub
                       const PartSum &sum) {
   Impl &I = *impl_;
   if (!I.built) throw std::runtime_error("gcfmm: evaluate() called before build()");
-  if (nparts < 1 || part < 0 || part >= nparts)
-    throw std::invalid_argument("gcfmm: evaluate() needs 0 <= part < nparts, got part " + std::to_string(part) +
-                                " of " + std::to_string(nparts));
+  SolverCore::check_part("evaluate()", part, nparts);
   const std::size_t n = I.n;
   if (n > 0 && (!q || !pot || !ex || !ey || !ez)) throw std::invalid_argument("gcfmm: evaluate() got a null array");
   I.evaluated = false;
@@ -65,15 +63,9 @@ void Solver::evaluate(const double *q, double *pot, double *ex, double *ey, doub
   std::size_t first, second;
   if (I.charged_coincident_pair(first, second)) throw coincidence_error(first, second, I.h);
   for (std::size_t i = 0; i < n; ++i) pot[i] = ex[i] = ey[i] = ez[i] = 0.0;
+  TargetRange t;
+  if (!I.start_phases(part, nparts, t)) return;
   Stats &s = I.stats;
-  s.t_upward = s.t_m2l = s.t_p2p = s.t_downward = s.t_far = 0.0;
-  I.evaluated = true;
-  I.last_range = TargetRange{};
-  if (n == 0) return;
-
-  const TargetRange t = I.range_of(part, nparts);
-  I.last_range = t;
-  I.clear_results(t);
   s.t_upward = timed([&] { I.upward(); });
   s.t_m2l = timed([&] { I.m2l(t); });
   s.t_p2p = timed([&] { I.p2p(t); });

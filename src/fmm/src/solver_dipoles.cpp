@@ -72,29 +72,6 @@ void SolverCore::p2p_dipoles(const TargetRange &t, bool gradient) {
   });
 }
 
-// L2L as in downward(); at the leaves L2P with the gradient (eq. (5.2)) where it is asked for.
-void SolverCore::downward_gradient(const TargetRange &t, bool gradient) {
-  if (!gradient) {
-    downward(t);
-    return;
-  }
-  const auto &nodes = tree.nodes;
-  const auto &xs = tree.xs, &ys = tree.ys, &zs = tree.zs;
-  for_target_nodes(t, [&](std::size_t i, const Node &A) {
-    double *Li = local_of(i);
-    if (A.parent >= 0 && has_local[A.parent]) {
-      ops->l2l(local_of(A.parent), A.center - nodes[A.parent].center, Li);
-      has_local[i] = 1;
-    }
-    if (!has_local[i]) return;
-    ops->symmetrize(Li);
-    if (!A.leaf()) return;
-    for (std::size_t k = t.first(A); k < t.last(A); ++k)
-      ops->l2p_gradient(Li, Vec3{xs[k], ys[k], zs[k]} - A.center, sorted_pot[k], sorted_ex[k], sorted_ey[k],
-                        sorted_ez[k], sorted_g.data() + 6 * k);
-  });
-}
-
 void SolverCore::far_field_dipoles(const TargetRange &t, bool gradient) {
   if (!periodic() || opts.farfield != FarField::Exact) return;
   far.evaluate_dipoles(n, tree.xs.data(), tree.ys.data(), tree.zs.data(), sorted_q.data(), sorted_px.data(),
@@ -127,9 +104,7 @@ void gcfmm::Solver::evaluate_dipoles(const DipoleSources &src, const FieldOutput
   using namespace detail;
   Impl &I = *impl_;
   if (!I.built) throw std::runtime_error("gcfmm: evaluate_dipoles() called before build()");
-  if (nparts < 1 || part < 0 || part >= nparts)
-    throw std::invalid_argument("gcfmm: evaluate_dipoles() needs 0 <= part < nparts, got part " +
-                                std::to_string(part) + " of " + std::to_string(nparts));
+  SolverCore::check_part("evaluate_dipoles()", part, nparts);
   if (I.periodic() && I.opts.farfield == FarField::Average)
     throw std::invalid_argument("gcfmm: evaluate_dipoles() has no average far field (its smeared images are "
                                 "of charges only): use FarField::Exact or None");
@@ -152,15 +127,9 @@ void gcfmm::Solver::evaluate_dipoles(const DipoleSources &src, const FieldOutput
     if (gradient)
       for (int c = 0; c < 6; ++c) out.gradient[6 * i + c] = 0.0;
   }
+  TargetRange t;
+  if (!I.start_phases(part, nparts, t)) return;
   Stats &s = I.stats;
-  s.t_upward = s.t_m2l = s.t_p2p = s.t_downward = s.t_far = 0.0;
-  I.evaluated = true;
-  I.last_range = TargetRange{};
-  if (n == 0) return;
-
-  const TargetRange t = I.range_of(part, nparts);
-  I.last_range = t;
-  I.clear_results(t);
   if (gradient) I.sorted_g.assign(6 * n, 0.0);
   s.t_upward = timed([&] {
     upward_pass(I.tree, I.sorted_q.data(), *I.ops, I.multipole, nullptr, I.sorted_px.data(), I.sorted_py.data(),
@@ -168,7 +137,7 @@ void gcfmm::Solver::evaluate_dipoles(const DipoleSources &src, const FieldOutput
   });
   s.t_m2l = timed([&] { I.m2l(t); });
   s.t_p2p = timed([&] { I.p2p_dipoles(t, gradient); });
-  s.t_downward = timed([&] { I.downward_gradient(t, gradient); });
+  s.t_downward = timed([&] { I.downward(t, gradient); });
   s.t_far = timed([&] { I.far_field_dipoles(t, gradient); });
   I.scatter_dipoles(t, out);
 }

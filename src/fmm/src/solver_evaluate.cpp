@@ -55,8 +55,9 @@ void SolverCore::p2p(const TargetRange &t) {
   });
 }
 
-// Downward pass: L2L from the parent (eq. (3.12)), L2P at leaves (eq. (3.13)).
-void SolverCore::downward(const TargetRange &t) {
+// Downward pass: L2L from the parent (eq. (3.12)), L2P at leaves (eq. (3.13)); with the
+// gradient (evaluate_dipoles) L2P to degree 2 (doc/polarization.md, eq. (5.2)) into sorted_g.
+void SolverCore::downward(const TargetRange &t, bool gradient) {
   const auto &nodes = tree.nodes;
   const auto &xs = tree.xs, &ys = tree.ys, &zs = tree.zs;
   for_target_nodes(t, [&](std::size_t i, const Node &A) {
@@ -67,8 +68,13 @@ void SolverCore::downward(const TargetRange &t) {
     }
     if (!has_local[i]) return;
     ops->symmetrize(Li);
-    if (A.leaf()) {
-      const std::size_t a = t.first(A), b = t.last(A);
+    if (!A.leaf()) return;
+    const std::size_t a = t.first(A), b = t.last(A);
+    if (gradient) {
+      for (std::size_t k = a; k < b; ++k)
+        ops->l2p_gradient(Li, Vec3{xs[k], ys[k], zs[k]} - A.center, sorted_pot[k], sorted_ex[k], sorted_ey[k],
+                          sorted_ez[k], sorted_g.data() + 6 * k);
+    } else {
       ops->l2p_batch(Li, A.center, b - a, xs.data() + a, ys.data() + a, zs.data() + a, sorted_pot.data() + a,
                      sorted_ex.data() + a, sorted_ey.data() + a, sorted_ez.data() + a);
     }
@@ -111,6 +117,23 @@ void SolverCore::scatter(const TargetRange &t, double *pot, double *ex, double *
     ey[i] = fe * sorted_ey[k];
     ez[i] = fe * sorted_ez[k];
   }
+}
+
+void SolverCore::check_part(const char *what, int part, int nparts) {
+  if (nparts < 1 || part < 0 || part >= nparts)
+    throw std::invalid_argument(std::string("gcfmm: ") + what + " needs 0 <= part < nparts, got part " +
+                                std::to_string(part) + " of " + std::to_string(nparts));
+}
+
+bool SolverCore::start_phases(int part, int nparts, TargetRange &t) {
+  stats.t_upward = stats.t_m2l = stats.t_p2p = stats.t_downward = stats.t_far = 0.0;
+  evaluated = true;
+  last_range = TargetRange{};
+  if (n == 0) return false;
+  t = range_of(part, nparts);
+  last_range = t;
+  clear_results(t);
+  return true;
 }
 
 void SolverCore::energy_potential(double *u) const {

@@ -314,7 +314,12 @@ struct SolverCore {
   void upward();
   void m2l(const detail::TargetRange &t);
   void p2p(const detail::TargetRange &t);
-  void downward(const detail::TargetRange &t);
+  void downward(const detail::TargetRange &t, bool gradient = false);
+  // evaluate()'s and evaluate_dipoles()'s checks and start: std::invalid_argument unless
+  // 0 <= part < nparts; the timings reset, the targets t of the part with their results
+  // zeroed (false if there are no particles)
+  static void check_part(const char *what, int part, int nparts);
+  bool start_phases(int part, int nparts, detail::TargetRange &t);
   void far_field(const detail::TargetRange &t, int part, int nparts, const PartSum &sum);
   // the average far field of a total charge qsum per cell in the bed [blo, bhi] (units of h) at
   // the targets t, its potential also kept apart for energy_potential()
@@ -329,7 +334,6 @@ struct SolverCore {
   // the first coincident pair with a charge or a dipole, as input indices i < j; false if none
   bool source_coincident_pair(std::size_t &i, std::size_t &j) const;
   void p2p_dipoles(const detail::TargetRange &t, bool gradient);
-  void downward_gradient(const detail::TargetRange &t, bool gradient);
   void far_field_dipoles(const detail::TargetRange &t, bool gradient);
   void scatter_dipoles(const detail::TargetRange &t, const FieldOutputs &out) const;
   // energy_potential() of the last evaluate() (solver.hpp)
