@@ -309,11 +309,11 @@ void FixCoulFMM::min_setup(int vflag)
 // a line search evaluates several trial positions within one step: always recompute
 void FixCoulFMM::min_post_force(int vflag)
 {
+  v_init(vflag);
   if (polarizable) {
     post_force_polarizable();
     return;
   }
-  v_init(vflag);
   compute_field(false);
   apply_field();
   remember_positions();

@@ -322,3 +322,20 @@ TEST(CoulFMMPolarize, BadInput)
   expect_match(with(sph, "fix fmm all coul/fmm efield 0 0 1", "5", "fix ef all efield 0 0 1"), "would both apply the field");
   expect_match(with(sph, "fix fmm all coul/fmm polarize 4", "5", "fix ef all efield 0 0 1"), "would not polarize the particles");
 }
+
+// minimize with every keyword: each force evaluation is a fresh solve at the trial positions
+// (min_post_force), the energy falls, and the virial is tallied there too (pressure finite)
+TEST(CoulFMMPolarize, MinimizeUsesTheCurrentPositions)
+{
+  auto atoms = random_spheres(8, 29, 6.0);
+  for (auto &a : atoms) a[3] = 0.3;
+  Lmp l;
+  spheres(l, "p p f", atoms, 6.0);
+  l.cmds({"fix fmm all coul/fmm accuracy 1e-8 polarize 3.8 efield 0 0 -0.5 electrode 0.5",
+          "fix_modify fmm energy yes virial yes", "thermo_style custom step pe press", "run 0 post no"});
+  const double e0 = l.var("pe");
+  // small steps: with pair_style zero nothing keeps the attracting spheres apart
+  l.cmds({"min_modify dmax 0.01", "minimize 0 1e-12 5 50"});
+  EXPECT_LT(l.var("pe"), e0);
+  EXPECT_TRUE(std::isfinite(l.var("press")));
+}
