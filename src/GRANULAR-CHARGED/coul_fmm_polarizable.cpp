@@ -65,6 +65,12 @@ void CoulFMMPolarizable::init(const gcfmm::Options &opts)
   induction.tolerance = s.tolerance > 0.0 ? s.tolerance : 0.1 * opts.accuracy;
   solver = std::make_unique<gcfmm::PolarizableSolver>(opts);
   solver->set_induction(induction);
+  // every rank computes its share of the targets of each evaluation, one sum completes them
+  // (each value comes from one rank: the same result as on one rank)
+  if (comm->nprocs > 1)
+    solver->set_partition(comm->me, comm->nprocs, [this](double *data, std::size_t count) {
+      MPI_Allreduce(MPI_IN_PLACE, data, (int) count, MPI_DOUBLE, MPI_SUM, world);
+    });
   gcfmm::PolarizableEnvironment env;
   // LAMMPS field units (force = qe2f q E) -> bare units (force = qqrd2e q E_bare)
   const double to_bare = force->qe2f / force->qqrd2e;

@@ -10,9 +10,10 @@
 // The keywords efield, polarize and electrode of fix coul/fmm: one evaluation of the group's
 // charges, induced dipoles, applied field and grounded electrode by gcfmm::PolarizableSolver
 // (src/fmm; doc/polarization.md), from the atoms to the solver and back. The atoms of all ranks
-// are gathered on every rank (sorted by ID, so that every rank solves the same system), every
-// rank solves it, each keeps its own atoms' results. The dipoles of the last evaluation, kept
-// by atom ID, start the next induction solve.
+// are gathered on every rank (sorted by ID, so that every rank solves the same system); each
+// FMM evaluation is split among the ranks by target and summed, so every rank holds the same
+// fields and dipoles; each keeps its own atoms' results. The dipoles of the last evaluation,
+// kept by atom ID, start the next induction solve.
 
 #ifndef LMP_COUL_FMM_POLARIZABLE_H
 #define LMP_COUL_FMM_POLARIZABLE_H

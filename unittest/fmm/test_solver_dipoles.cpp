@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <condition_variable>
+#include <mutex>
 #include <random>
+#include <thread>
 #include <stdexcept>
 #include <vector>
 
@@ -553,5 +556,58 @@ TEST(SolverDipoles, TargetsSubset)
     EXPECT_EQ(some.ez[i], target ? all.ez[i] : 0.0) << i;
     EXPECT_EQ(some.pot[i], target ? all.pot[i] : 0.0) << i;
     EXPECT_EQ(some.g[6 * i + 2], target ? all.g[6 * i + 2] : 0.0) << i;
+  }
+}
+
+// set_partition: three parts run one after the other, their results summed as a communicator
+// would, give the one-part solution bit for bit (dipoles, forces, energy)
+TEST(PolarizableSolver, PartsSumToTheWhole)
+{
+  const Sources s = lattice(4, 43);
+  std::vector<double> alpha(s.size(), polarizability(0.6, 0.2));
+  PolarizableEnvironment env;
+  env.applied_field = {0.0, 0.0, 1.5};
+  env.electrode = true;
+  const Options o = high_accuracy(Boundary::Periodic2D, FarField::Exact);
+  const Polarized whole = polarize(s, alpha, o, env, 2.0);
+  // the parts in lock-step: each evaluation of part k is completed by the others' at the same
+  // call; a sequential emulation runs the three solvers on threads that meet at every sum
+  const int nparts = 3;
+  std::vector<std::vector<double>> p(nparts, std::vector<double>(3 * s.size(), 0.0));
+  std::vector<PolarizableOutputs> out(nparts);
+  std::vector<double> energy(nparts);
+  std::mutex m;
+  std::condition_variable cv;
+  std::vector<double> acc;
+  int arrived = 0, generation = 0;
+  auto sum = [&](double *data, std::size_t count) {
+    std::unique_lock<std::mutex> lock(m);
+    const int gen = generation;
+    if (arrived == 0) acc.assign(count, 0.0);
+    for (std::size_t k = 0; k < count; ++k) acc[k] += data[k];
+    if (++arrived == nparts) {
+      arrived = 0;
+      ++generation;
+      cv.notify_all();
+    } else {
+      cv.wait(lock, [&] { return generation != gen; });
+    }
+    std::copy(acc.begin(), acc.begin() + count, data);
+  };
+  std::vector<std::thread> threads;
+  for (int k = 0; k < nparts; ++k)
+    threads.emplace_back([&, k] {
+      PolarizableSolver solver(o);
+      solver.set_box(0.0, 0.0, 2.0, 2.0);
+      solver.set_environment(env);
+      solver.set_partition(k, nparts, sum);
+      solver.compute(s.size(), s.x.data(), s.y.data(), s.z.data(), s.q.data(), alpha.data(), p[k].data(), out[k]);
+      energy[k] = solver.energy();
+    });
+  for (auto &t : threads) t.join();
+  for (int k = 0; k < nparts; ++k) {
+    EXPECT_EQ(p[k], whole.p) << "part " << k;
+    EXPECT_EQ(out[k].force, whole.out.force) << "part " << k;
+    EXPECT_EQ(energy[k], whole.energy) << "part " << k;
   }
 }

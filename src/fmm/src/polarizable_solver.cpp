@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "gcfmm/dipole_kernels.hpp"
 
@@ -35,6 +36,15 @@ void PolarizableSolver::set_induction(const PolarizationSettings &settings) {
   induction_ = settings;
 }
 
+void PolarizableSolver::set_partition(int part, int nparts, PartSum sum) {
+  if (nparts < 1 || part < 0 || part >= nparts || (nparts > 1 && !sum))
+    throw std::invalid_argument("gcfmm: PolarizableSolver::set_partition needs 0 <= part < nparts and a sum "
+                                "for nparts > 1");
+  part_ = part;
+  nparts_ = nparts;
+  sum_ = std::move(sum);
+}
+
 void PolarizableSolver::evaluate(const double *p, bool charges, bool gradient) {
   const std::size_t ns = sx_.size();
   if (p) {
@@ -59,7 +69,29 @@ void PolarizableSolver::evaluate(const double *p, bool charges, bool gradient) {
   }
   g_.resize(gradient ? 6 * ns : 0);
   // the images are sources only
-  solver_.evaluate_dipoles(src, {pot_.data(), ex_.data(), ey_.data(), ez_.data(), gradient ? g_.data() : nullptr, n_});
+  solver_.evaluate_dipoles(src, {pot_.data(), ex_.data(), ey_.data(), ez_.data(), gradient ? g_.data() : nullptr, n_},
+                           part_, nparts_);
+  if (nparts_ == 1) return;
+  // the parts' results of the n particles, in one sum
+  const std::size_t per = gradient ? 10 : 4;
+  buffer_.resize(per * n_);
+  for (std::size_t i = 0; i < n_; ++i) {
+    double *b = buffer_.data() + per * i;
+    b[0] = pot_[i];
+    b[1] = ex_[i];
+    b[2] = ey_[i];
+    b[3] = ez_[i];
+    for (std::size_t c = 4; c < per; ++c) b[c] = g_[6 * i + c - 4];
+  }
+  sum_(buffer_.data(), buffer_.size());
+  for (std::size_t i = 0; i < n_; ++i) {
+    const double *b = buffer_.data() + per * i;
+    pot_[i] = b[0];
+    ex_[i] = b[1];
+    ey_[i] = b[2];
+    ez_[i] = b[3];
+    for (std::size_t c = 4; c < per; ++c) g_[6 * i + c - 4] = b[c];
+  }
 }
 
 void PolarizableSolver::compute(std::size_t n, const double *x, const double *y, const double *z, const double *q,

@@ -46,6 +46,13 @@ class PolarizableSolver {
   void set_environment(const PolarizableEnvironment &env);
   /** @brief The induction's stopping rule (default: residual 0.1 x Options::accuracy). */
   void set_induction(const PolarizationSettings &settings);
+  /** @brief Split every evaluation among nparts callers running at once (e.g. MPI ranks):
+   *  each computes the targets of its work partition (Solver::evaluate_dipoles) and `sum`
+   *  adds the callers' results in place (each value is nonzero on one caller only, so the
+   *  result is bit-identical to nparts = 1). All callers then hold the same fields and solve
+   *  the same induction. Default: one part.
+   *  @throws std::invalid_argument unless 0 <= part < nparts and, for nparts > 1, sum is set */
+  void set_partition(int part, int nparts, PartSum sum);
 
   /** @brief Dipoles, fields, forces and energy of n particles with charges q and
    *  polarizabilities alpha (null: none, p = 0). p (3 n): in, the starting dipoles (warm
@@ -67,6 +74,9 @@ class PolarizableSolver {
   // into pot, ex, ey, ez (2 n each) and g (6 x 2 n, or none)
   void evaluate(const double *p, bool charges, bool gradient);
   Solver solver_;
+  int part_ = 0, nparts_ = 1;
+  PartSum sum_;
+  std::vector<double> buffer_;  // the results of the n particles, summed over the parts
   PolarizableEnvironment env_;
   PolarizationSettings induction_;
   PolarizationReport report_;
