@@ -9,7 +9,9 @@
 // electrode at z = 0. Periodic2D, images 1, far field exact, column [0, 160] by set_z_range.
 // Columns, without and with the electrode: the charges-only evaluation (Solver::evaluate, or
 // PolarizableSolver without alpha with the electrode's images), polarize from p = 0 (cold),
-// polarize warm-started after every particle moved by 0.01 (a deposition step), and the ratio.
+// polarize warm-started after every particle moved by up to --step per coordinate (a
+// deposition step), polarize two steps later started from the dipoles extrapolated from the
+// last two (2 p_n - p_{n-1}), with the FMM evaluations of each and the ratios.
 //
 // usage: bench_polarize [--n N[,N...]] [--acc a] [--reps r] [--step s]
 // --step: the displacement (uniform in [-s, s] per coordinate) between the cold and the warm
@@ -98,17 +100,18 @@ int main(int argc, char **argv) {
     else if (k == "--step") step = std::atof(argv[i + 1]);
   }
   std::printf("# accuracy %g, best of %d, seconds per evaluation (build included), warm start after a step of\n"
-              "# %g radii; it: the induction's evaluations; ratios against the charges-only evaluation of the\n"
-              "# same geometry\n", acc, reps, step);
-  std::printf("%8s %10s %10s %6s %10s %6s %7s | %10s %10s %6s %10s %6s %7s\n", "N", "charges", "cold", "it", "warm",
-              "it", "warm/q", "q+electr.", "cold", "it", "warm", "it", "warm/q");
+              "# %g radii; pred: the second step started from the dipoles extrapolated from the last two;\n"
+              "# ev: FMM evaluations of the step; ratios against the charges-only evaluation of the same geometry\n", acc, reps, step);
+  std::printf("%8s %9s %9s %3s %9s %3s %6s %9s %3s %6s | %9s %9s %3s %9s %3s %6s %9s %3s %6s\n", "N", "charges",
+              "cold", "ev", "warm", "ev", "w/q", "pred", "ev", "p/q", "q+images", "cold", "ev", "warm", "ev", "w/q",
+              "pred", "ev", "p/q");
   for (const std::size_t n : ns) {
     const Bed b = deposition(n, 7);
     std::vector<double> alpha(n, polarizability(clausius_mossotti(3.8, 1.0), 1.0));
     std::printf("%8zu", n);
     for (const bool electrode : {false, true}) {
-      double t_q = 1e30, t_cold = 1e30, t_warm = 1e30;
-      int it_cold = 0, it_warm = 0;
+      double t_q = 1e30, t_cold = 1e30, t_warm = 1e30, t_pred = 1e30;
+      int it_cold = 0, it_warm = 0, it_pred = 0;
       PolarizableEnvironment env;
       env.applied_field = {0.0, 0.0, 0.05};
       env.electrode = electrode;
@@ -138,19 +141,41 @@ int main(int argc, char **argv) {
         t0 = std::chrono::steady_clock::now();
         ps.compute(n, b.x.data(), b.y.data(), b.z.data(), b.q.data(), alpha.data(), p.data(), out);
         t_cold = std::min(t_cold, seconds_since(t0));
-        it_cold = ps.report().iterations;
-        std::vector<double> x = b.x, y = b.y, z = b.z;
+        it_cold = ps.evaluations();
+        // every particle moves by a constant step of up to `step` per coordinate
         std::mt19937_64 g(r + 11);
         std::uniform_real_distribution<double> u(-step, step);
+        std::vector<double> vx(n), vy(n), vz(n);
         for (std::size_t i = 0; i < n; ++i) {
-          x[i] += u(g);
-          y[i] += u(g);
-          z[i] += u(g);
+          vx[i] = u(g);
+          vy[i] = u(g);
+          vz[i] = u(g);
         }
+        std::vector<double> x = b.x, y = b.y, z = b.z, p_prev = p;
+        auto advance = [&] {
+          for (std::size_t i = 0; i < n; ++i) {
+            x[i] += vx[i];
+            y[i] += vy[i];
+            z[i] += vz[i];
+          }
+        };
+        advance();
         t0 = std::chrono::steady_clock::now();
         ps.compute(n, x.data(), y.data(), z.data(), b.q.data(), alpha.data(), p.data(), out);
         t_warm = std::min(t_warm, seconds_since(t0));
-        it_warm = ps.report().iterations;
+        it_warm = ps.evaluations();
+        // then two steps started from the dipoles extrapolated from the last two, 2 p_n - p_{n-1}
+        for (int k = 0; k < 2; ++k) {
+          advance();
+          std::vector<double> guess(3 * n);
+          for (std::size_t j = 0; j < 3 * n; ++j) guess[j] = 2.0 * p[j] - p_prev[j];
+          p_prev = p;
+          p = guess;
+          t0 = std::chrono::steady_clock::now();
+          ps.compute(n, x.data(), y.data(), z.data(), b.q.data(), alpha.data(), p.data(), out);
+          if (k == 1) t_pred = std::min(t_pred, seconds_since(t0));
+        }
+        it_pred = ps.evaluations();
         if (std::getenv("BENCH_STATS")) {
           const Stats &st = ps.stats();
           std::printf("\n# last evaluation: build %.4f upward %.4f m2l %.4f p2p %.4f down %.4f far %.4f order %d"
@@ -158,8 +183,8 @@ int main(int argc, char **argv) {
                       st.order, st.p2p_pairs);
         }
       }
-      std::printf(" %10.4f %10.4f %6d %10.4f %6d %7.2f%s", t_q, t_cold, it_cold, t_warm, it_warm, t_warm / t_q,
-                  electrode ? "\n" : " |");
+      std::printf(" %9.4f %9.4f %3d %9.4f %3d %6.2f %9.4f %3d %6.2f%s", t_q, t_cold, it_cold, t_warm, it_warm,
+                  t_warm / t_q, t_pred, it_pred, t_pred / t_q, electrode ? "\n" : " |");
     }
   }
   return 0;

@@ -14,6 +14,7 @@
 #include "domain.h"
 #include "error.h"
 #include "force.h"
+#include "update.h"
 
 #include "gcfmm/dipole_kernels.hpp"
 #include "gcfmm/far_field.hpp"
@@ -123,7 +124,7 @@ void CoulFMMPolarizable::gather()
   }
 }
 
-double CoulFMMPolarizable::evaluate(double **field, double **force_out)
+double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool predict)
 {
   gather();
   const size_t n = gtag.size();
@@ -135,10 +136,15 @@ double CoulFMMPolarizable::evaluate(double **field, double **force_out)
   if (n == 0) return 0.0;
   // warm start: the last solution of the atoms that are still there (both lists sorted by ID)
   gp.assign(3 * n, 0.0);
-  for (size_t k = 0, m = 0; k < n && m < last_tag.size(); k++) {
+  const bigint step = update->ntimestep;
+  const bool linear = predict && last_step == step - 1 && prev_step == step - 2;
+  for (size_t k = 0, m = 0, l = 0; k < n && m < last_tag.size(); k++) {
     while (m < last_tag.size() && last_tag[m] < gtag[k]) m++;
-    if (m < last_tag.size() && last_tag[m] == gtag[k])
-      for (int a = 0; a < 3; a++) gp[3 * k + a] = last_p[3 * m + a];
+    if (m == last_tag.size() || last_tag[m] != gtag[k]) continue;
+    while (l < prev_tag.size() && prev_tag[l] < gtag[k]) l++;
+    const bool both = linear && l < prev_tag.size() && prev_tag[l] == gtag[k];
+    for (int a = 0; a < 3; a++)
+      gp[3 * k + a] = both ? 2.0 * last_p[3 * m + a] - prev_p[3 * l + a] : last_p[3 * m + a];
   }
   gcfmm::PolarizableOutputs out;
   std::string failure;
@@ -176,8 +182,12 @@ double CoulFMMPolarizable::evaluate(double **field, double **force_out)
                "{:.3g} after {} iterations): the particles overlap too much for point dipoles",
                rep.residual, s.tolerance > 0.0 ? s.tolerance : 0.1 * solver->options().accuracy,
                rep.iterations);
+  prev_tag.swap(last_tag);
+  prev_p.swap(last_p);
+  prev_step = last_step;
   last_tag = gtag;
   last_p = gp;
+  last_step = step;
 
   // this rank's atoms (binary search by ID in the sorted list); bare -> LAMMPS units
   const double c = force->qqrd2e;

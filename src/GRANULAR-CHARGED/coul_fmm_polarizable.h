@@ -52,7 +52,9 @@ class CoulFMMPolarizable : protected Pointers {
   // field[i][0..3] = Ex, Ey, Ez (applied field included) and the potential of the charges;
   // field[i][4..6] = the dipole (charge x distance; polarize only); force[i][0..2] = q E + (p . grad) E, all in
   // LAMMPS units, zero outside the group; returns this rank's part of the energy
-  double evaluate(double **field, double **force);
+  // predict: start from the dipoles extrapolated from the last two steps when they were the
+  // two steps before this one (false: from the last solution; e.g. in a minimization)
+  double evaluate(double **field, double **force, bool predict = true);
 
   // the solver's error estimate, order, M2L and P2P counts of the last evaluation
   double estimated_error() const;
@@ -72,9 +74,11 @@ class CoulFMMPolarizable : protected Pointers {
   // all atoms of the group, sorted by ID: tag, x, y, z, q, alpha (bare units)
   std::vector<double> gx, gy, gz, gq, galpha, gp;
   std::vector<tagint> gtag;
-  // the last solution, by atom ID (sorted), for the warm start
-  std::vector<tagint> last_tag;
-  std::vector<double> last_p;
+  // the last two solutions, by atom ID (sorted), and their steps: the warm start is the last
+  // one, or 2 p_n - p_{n-1} after two consecutive steps (a linear prediction)
+  std::vector<tagint> last_tag, prev_tag;
+  std::vector<double> last_p, prev_p;
+  bigint last_step = -1, prev_step = -1;
   int last_iterations = 0;
   double last_residual = 0.0;
 

@@ -311,7 +311,7 @@ void FixCoulFMM::min_post_force(int vflag)
 {
   v_init(vflag);
   if (polarizable) {
-    post_force_polarizable();
+    post_force_polarizable(false);    // trial positions: no prediction from the last steps
     return;
   }
   compute_field(false);
@@ -323,7 +323,7 @@ void FixCoulFMM::post_force(int vflag)
 {
   v_init(vflag);
   if (polarizable) {
-    post_force_polarizable();
+    post_force_polarizable(true);
     return;
   }
   const bigint step = update->ntimestep;
@@ -428,9 +428,9 @@ void FixCoulFMM::add_force(int i, const double *fi, bool in_plane)
 
 // efield, polarize, electrode: F_i = q_i E_i + (p_i . grad) E_i and the energy of
 // doc/polarization.md, eq. (3.4), evaluated every step; virial as in apply_field()
-void FixCoulFMM::post_force_polarizable()
+void FixCoulFMM::post_force_polarizable(bool predict)
 {
-  energy_local = polarizable->evaluate(field, polar_force);
+  energy_local = polarizable->evaluate(field, polar_force, predict);
   energy_summed = false;
   nevaluations++;
   const bool in_plane = opts->boundary != gcfmm::Boundary::Periodic2D;

@@ -101,7 +101,7 @@ class FixCoulFMM : public Fix {
   void advance_field();
   void apply_field();
   void remember_positions();
-  void post_force_polarizable();
+  void post_force_polarizable(bool predict);
   void add_force(int i, const double *fi, bool in_plane);
 };
 

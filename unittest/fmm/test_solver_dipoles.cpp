@@ -611,3 +611,44 @@ TEST(PolarizableSolver, PartsSumToTheWhole)
     EXPECT_EQ(energy[k], whole.energy) << "part " << k;
   }
 }
+
+// A start that already solves (3.3) twice in a row: the second time its evaluation carries the
+// gradient and is the only one, with the forces of the full path bit for bit; a start that
+// does not (the particles moved) falls back to the iterations and the forces' evaluation
+TEST(PolarizableSolver, ConvergedStartIsTheOnlyEvaluation)
+{
+  Sources s = lattice(3, 47);
+  std::vector<double> alpha(s.size(), polarizability(0.6, 0.2));
+  PolarizableEnvironment env;
+  env.applied_field = {0.0, 0.0, 1.5};
+  env.electrode = true;
+  PolarizableSolver solver(high_accuracy());
+  solver.set_environment(env);
+  std::vector<double> p(3 * s.size(), 0.0);
+  PolarizableOutputs a, b, c, d;
+  auto run = [&](PolarizableOutputs &o) {
+    solver.compute(s.size(), s.x.data(), s.y.data(), s.z.data(), s.q.data(), alpha.data(), p.data(), o);
+  };
+  run(a);  // cold: start + iterations + forces
+  EXPECT_GT(solver.evaluations(), 2);
+  run(b);  // from the solution: the start converges, then the forces' evaluation
+  EXPECT_EQ(solver.report().iterations, 1);
+  EXPECT_EQ(solver.evaluations(), 2);
+  run(c);  // the start carries the gradient and converges again: one evaluation
+  EXPECT_EQ(solver.evaluations(), 1);
+  EXPECT_EQ(c.force, b.force);
+  for (std::size_t i = 0; i < s.size(); ++i) s.z[i] += 0.02;  // moved: the start is off
+  run(d);
+  EXPECT_GT(solver.evaluations(), 2);
+  PolarizableSolver fresh(high_accuracy());
+  fresh.set_environment(env);
+  std::vector<double> p0(3 * s.size(), 0.0);
+  PolarizableOutputs e;
+  fresh.compute(s.size(), s.x.data(), s.y.data(), s.z.data(), s.q.data(), alpha.data(), p0.data(), e);
+  double num = 0, den = 0;
+  for (std::size_t k = 0; k < e.force.size(); ++k) {
+    num += std::pow(d.force[k] - e.force[k], 2);
+    den += e.force[k] * e.force[k];
+  }
+  EXPECT_LT(std::sqrt(num / den), 1e-7);
+}

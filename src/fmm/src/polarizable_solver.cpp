@@ -13,7 +13,9 @@
 namespace gcfmm {
 
 PolarizableSolver::PolarizableSolver(const Options &opts) : solver_(opts) {
-  induction_.tolerance = 0.1 * solver_.options().accuracy;
+  PolarizationSettings s;
+  s.tolerance = 0.1 * solver_.options().accuracy;
+  set_induction(s);
 }
 
 void PolarizableSolver::set_box(double xlo, double ylo, double lx, double ly) { solver_.set_box(xlo, ylo, lx, ly); }
@@ -33,7 +35,11 @@ void PolarizableSolver::set_environment(const PolarizableEnvironment &env) {
 void PolarizableSolver::set_induction(const PolarizationSettings &settings) {
   if (!(settings.tolerance > 0.0) || settings.max_iterations < 1)
     throw std::invalid_argument("gcfmm: the induction needs a tolerance > 0 and max_iterations >= 1");
+  // iterate to a quarter of the tolerance, accept a start within it: a start extrapolated from
+  // the last two solutions (errors up to ~3/4 of the tolerance, plus the motion's) is accepted
   induction_ = settings;
+  induction_.accept_start = settings.tolerance;
+  induction_.tolerance = 0.25 * settings.tolerance;
 }
 
 void PolarizableSolver::set_partition(int part, int nparts, PartSum sum) {
@@ -46,6 +52,7 @@ void PolarizableSolver::set_partition(int part, int nparts, PartSum sum) {
 }
 
 void PolarizableSolver::evaluate(const double *p, bool charges, bool gradient) {
+  ++evaluations_;
   const std::size_t ns = sx_.size();
   if (p) {
     for (std::size_t i = 0; i < n_; ++i) {
@@ -125,8 +132,12 @@ void PolarizableSolver::compute(std::size_t n, const double *x, const double *y,
     for (std::size_t k = 0; k < 3 * n; ++k) p[k] = 0.0;
   // one evaluation of the charges and the starting dipoles: the local field E0 + T p of the
   // induction's start (no evaluation of E0 apart)
+  // the start's evaluation carries the gradient when the last step's start was already the
+  // solution (a predicted warm start often is): then it is also the forces' evaluation
+  const bool start_is_final = alpha && start_converged_;
+  evaluations_ = 0;
   if (alpha) {
-    evaluate(p, true, false);
+    evaluate(p, true, start_is_final);
     std::vector<double> local(3 * n);
     for (std::size_t i = 0; i < n; ++i) {
       local[3 * i] = ex_[i] + ea.x;
@@ -142,12 +153,14 @@ void PolarizableSolver::compute(std::size_t n, const double *x, const double *y,
       }
     };
     report_ = solve_induced_dipoles_from(n, alpha, local.data(), field, p, induction_);
+    start_converged_ = report_.iterations == 0;
     report_.iterations += 1;  // the first evaluation
   } else {
     report_.converged = true;
+    start_converged_ = false;
   }
   // the field and its gradient with the converged dipoles
-  evaluate(alpha ? p : nullptr, true, true);
+  if (!(start_is_final && start_converged_)) evaluate(alpha ? p : nullptr, true, true);
 
   out.field.assign(3 * n, 0.0);
   out.force.assign(3 * n, 0.0);

@@ -98,6 +98,12 @@ PolarizationReport solve_induced_dipoles_from(std::size_t n, const double *alpha
   // the residual measure: || alpha r || / || alpha (E0 + T x_start) || (preconditioned residual)
   auto residual = [&]() { return std::sqrt(dot(z, z)) / bnorm; };
   rep.residual = residual();
+  const double accept = settings.accept_start > 0.0 ? settings.accept_start : settings.tolerance;
+  if (rep.residual <= accept) {
+    rep.converged = true;
+    for (std::size_t k = 0; k < m; ++k) p[k] = x[k];
+    return rep;
+  }
   d = z;
   double rz = dot(r, z);
   while (rep.residual > settings.tolerance && rep.iterations < settings.max_iterations) {

@@ -44,7 +44,8 @@ class PolarizableSolver {
   void set_z_range(double zlo, double zhi);
   /** @throws std::invalid_argument if a component of the field or electrode_z is not finite. */
   void set_environment(const PolarizableEnvironment &env);
-  /** @brief The induction's stopping rule (default: residual 0.1 x Options::accuracy). */
+  /** @brief The induction's stopping rule (default: residual 0.1 x Options::accuracy): a
+   *  start within `tolerance` is accepted, iterations go on to tolerance / 4. */
   void set_induction(const PolarizationSettings &settings);
   /** @brief Split every evaluation among nparts callers running at once (e.g. MPI ranks):
    *  each computes the targets of its work partition (Solver::evaluate_dipoles) and `sum`
@@ -58,13 +59,17 @@ class PolarizableSolver {
    *  polarizabilities alpha (null: none, p = 0). p (3 n): in, the starting dipoles (warm
    *  start); out, the solution. Evaluations: one of the charges and the starting dipoles,
    *  one per induction iteration, and a last one with the field gradient;
-   *  report().iterations counts them all but the last.
+   *  report().iterations counts them all but the last. When the last call's start already
+   *  solved (3.3) (a good prediction of the dipoles, e.g. extrapolated from the last two
+   *  steps), the start's evaluation carries the gradient, and if the start solves (3.3) again
+   *  it is the only evaluation.
    *  @throws std::invalid_argument if a particle is at or below the electrode, or as
    *  solve_induced_dipoles(); CoincidentParticles as Solver::evaluate_dipoles. */
   void compute(std::size_t n, const double *x, const double *y, const double *z, const double *q,
                const double *alpha, double *p, PolarizableOutputs &out);
 
   const PolarizationReport &report() const { return report_; }  //!< the last induction solve
+  int evaluations() const { return evaluations_; }  //!< FMM evaluations of the last compute()
   double energy() const { return energy_; }                      //!< total energy of the last compute()
   const Stats &stats() const { return solver_.stats(); }        //!< the FMM's last evaluation
   const Options &options() const { return solver_.options(); }
@@ -75,6 +80,8 @@ class PolarizableSolver {
   void evaluate(const double *p, bool charges, bool gradient);
   Solver solver_;
   int part_ = 0, nparts_ = 1;
+  bool start_converged_ = false;  // the last compute()'s start already solved (3.3)
+  int evaluations_ = 0;
   PartSum sum_;
   std::vector<double> buffer_;  // the results of the n particles, summed over the parts
   PolarizableEnvironment env_;

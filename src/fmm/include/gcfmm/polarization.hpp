@@ -17,6 +17,10 @@ struct PolarizationSettings {
   /// relative residual || alpha (E0 + T p) - p || / || alpha E0 || (2-norms over all components)
   double tolerance = 1e-6;
   int max_iterations = 200;  //!< operator applications before giving up
+  /// solve_induced_dipoles_from(): a start whose residual is at most this is the solution
+  /// without iterating (0: tolerance). Iterating to a tolerance below it keeps solutions that
+  /// are extrapolated from the last two (errors ~3 x tolerance) acceptable starts.
+  double accept_start = 0.0;
 };
 
 //! What the last solve did.
