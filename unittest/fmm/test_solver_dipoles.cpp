@@ -102,6 +102,19 @@ Errors errors(const Result &a, const Result &ref)
   return {std::sqrt(np / dp), std::sqrt(ne / de), std::sqrt(ng / dg)};
 }
 
+// the direct reference's view of the particles s with polarizabilities alpha
+PolarizableSystem system_of(const Sources &s, const std::vector<double> &alpha)
+{
+  PolarizableSystem sys;
+  sys.n = s.size();
+  sys.x = s.x.data();
+  sys.y = s.y.data();
+  sys.z = s.z.data();
+  sys.q = s.q.data();
+  sys.alpha = alpha.data();
+  return sys;
+}
+
 Options high_accuracy(Boundary b = Boundary::Free, FarField ff = FarField::None)
 {
   Options o;
@@ -311,13 +324,7 @@ TEST(SolverDipoles, InducedDipolesByFmmMatchDirectSolve)
     s.z[i] = 0.25 + 0.5 * (i / 36) + jitter(g);
   }
   std::vector<double> alpha(s.size(), polarizability(0.5, 0.2));
-  PolarizableSystem sys;
-  sys.n = s.size();
-  sys.x = s.x.data();
-  sys.y = s.y.data();
-  sys.z = s.z.data();
-  sys.q = s.q.data();
-  sys.alpha = alpha.data();
+  PolarizableSystem sys = system_of(s, alpha);
   sys.applied_field = {0.0, 0.0, 2.0};
   PolarizationSettings set;
   set.tolerance = 1e-10;
@@ -473,13 +480,7 @@ TEST(PolarizableSolver, MatchesDirectReference)
     const Polarized f = polarize(s, alpha, o, env, 2.0);
     EXPECT_TRUE(f.report.converged);
 
-    PolarizableSystem sys;
-    sys.n = s.size();
-    sys.x = s.x.data();
-    sys.y = s.y.data();
-    sys.z = s.z.data();
-    sys.q = s.q.data();
-    sys.alpha = alpha.data();
+    PolarizableSystem sys = system_of(s, alpha);
     sys.applied_field = env.applied_field;
     sys.electrode = true;
     sys.electrode_z = 0.0;
