@@ -24,14 +24,19 @@ using namespace LAMMPS_NS;
    the domain decomposition
 ------------------------------------------------------------------------- */
 
-void CoulFMMComm::gather(const std::function<bool(int)> &take, GatheredCharges &out)
+void CoulFMMComm::gather(const std::function<bool(int)> &take, GatheredCharges &out,
+                         const double *extra)
 {
   double **x = atom->x;
   double *q = atom->q;
   tagint *tag = atom->tag;
+  const int per = extra ? 6 : 5;
   buf.clear();
-  for (int i = 0; i < atom->nlocal; i++)
-    if (take(i)) buf.insert(buf.end(), {(double) tag[i], x[i][0], x[i][1], x[i][2], q[i]});
+  for (int i = 0; i < atom->nlocal; i++) {
+    if (!take(i)) continue;
+    buf.insert(buf.end(), {(double) tag[i], x[i][0], x[i][1], x[i][2], q[i]});
+    if (extra) buf.push_back(extra[i]);
+  }
 
   const int nprocs = comm->nprocs;
   std::vector<int> counts(nprocs), displs(nprocs);
@@ -45,27 +50,29 @@ void CoulFMMComm::gather(const std::function<bool(int)> &take, GatheredCharges &
   MPI_Allgatherv(buf.data(), mine, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE,
                  world);
   out.counts.resize(nprocs);
-  for (int p = 0; p < nprocs; p++) out.counts[p] = counts[p] / 5;
+  for (int p = 0; p < nprocs; p++) out.counts[p] = counts[p] / per;
   collectives.count_received((double) (total - mine) * sizeof(double));
 
-  const size_t n = total / 5;
+  const size_t n = total / per;
   out.order.resize(n);
   std::iota(out.order.begin(), out.order.end(), 0);
   std::sort(out.order.begin(), out.order.end(), [&](size_t a, size_t b) {
-    return all[5 * a] < all[5 * b];
+    return all[per * a] < all[per * b];
   });
   out.tag.resize(n);
   out.x.resize(n);
   out.y.resize(n);
   out.z.resize(n);
   out.q.resize(n);
+  out.extra.resize(extra ? n : 0);
   for (size_t k = 0; k < n; k++) {
-    const double *r = &all[5 * out.order[k]];
+    const double *r = &all[per * out.order[k]];
     out.tag[k] = (tagint) r[0];
     out.x[k] = r[1];
     out.y[k] = r[2];
     out.z[k] = r[3];
     out.q[k] = r[4];
+    if (extra) out.extra[k] = r[5];
   }
 }
 

@@ -31,6 +31,7 @@ namespace LAMMPS_NS {
 // atoms of all ranks, sorted by atom ID (identical on every rank)
 struct GatheredCharges {
   std::vector<double> x, y, z, q;
+  std::vector<double> extra;    // gather()'s optional per-atom value (empty without one)
   std::vector<tagint> tag;
   std::vector<size_t> order;    // sorted position -> position in the gather (rank blocks)
   std::vector<int> counts;      // atoms of each rank
@@ -68,8 +69,9 @@ class CoulFMMComm : protected Pointers {
   // for gcfmm::DistributedSolver; its byte count includes gather() and return_to_owners()
   CoulFMMCollectives collectives;
 
-  // the local atoms i with take(i) of every rank into `out`
-  void gather(const std::function<bool(int)> &take, GatheredCharges &out);
+  // the local atoms i with take(i) of every rank into `out`, and extra[i] into out.extra if given
+  void gather(const std::function<bool(int)> &take, GatheredCharges &out,
+              const double *extra = nullptr);
   // values[4 k .. 4 k + 3] of gathered atom k, each computed by one rank and zero on the others:
   // summed over the ranks, and this rank's atoms handed back in the order gather() took them
   void return_to_owners(const GatheredCharges &g, const std::vector<double> &values,

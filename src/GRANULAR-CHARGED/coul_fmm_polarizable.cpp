@@ -9,6 +9,8 @@
 
 #include "coul_fmm_polarizable.h"
 
+#include "coul_fmm_comm.h"
+
 #include "atom.h"
 #include "comm.h"
 #include "domain.h"
@@ -29,7 +31,7 @@
 using namespace LAMMPS_NS;
 
 CoulFMMPolarizable::CoulFMMPolarizable(LAMMPS *lmp, const Settings &settings, int groupbit_) :
-    Pointers(lmp), s(settings), groupbit(groupbit_)
+    Pointers(lmp), s(settings), groupbit(groupbit_), mpi(new CoulFMMComm(lmp))
 {
 }
 
@@ -81,52 +83,27 @@ void CoulFMMPolarizable::init(const gcfmm::Options &opts)
   solver->set_environment(env);
 }
 
-// every rank: the group's atoms of all ranks, sorted by ID
+// every rank: the group's atoms of all ranks, sorted by ID (CoulFMMComm::gather), with their
+// polarizabilities from the radii
 void CoulFMMPolarizable::gather()
 {
-  const int nlocal = atom->nlocal;
-  const int per = 6;
-  std::vector<double> mine;
+  const int bit = groupbit;
+  mpi->gather([this, bit](int i) { return (atom->mask[i] & bit) != 0; }, gathered,
+              s.polarize ? atom->radius : nullptr);
   const double beta = s.polarize
       ? gcfmm::clausius_mossotti(s.eps_particle, s.eps_medium > 0.0 ? s.eps_medium : force->dielectric)
       : 0.0;
-  for (int i = 0; i < nlocal; i++) {
-    if (!(atom->mask[i] & groupbit)) continue;
-    double xu[3];
-    domain->unmap(atom->x[i], atom->image[i], xu);
-    const double alpha = s.polarize ? gcfmm::polarizability(beta, atom->radius[i]) : 0.0;
-    const double v[per] = {(double) atom->tag[i], periodic ? atom->x[i][0] : xu[0],
-                           periodic ? atom->x[i][1] : xu[1], xu[2], atom->q[i], alpha};
-    mine.insert(mine.end(), v, v + per);
-  }
-  int count = (int) mine.size(), nprocs = comm->nprocs;
-  std::vector<int> counts(nprocs), displs(nprocs, 0);
-  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
-  for (int r = 1; r < nprocs; r++) displs[r] = displs[r - 1] + counts[r - 1];
-  std::vector<double> all(displs[nprocs - 1] + counts[nprocs - 1]);
-  MPI_Allgatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(),
-                 MPI_DOUBLE, world);
-  const size_t n = all.size() / per;
-  std::vector<size_t> order(n);
-  std::iota(order.begin(), order.end(), size_t(0));
-  std::sort(order.begin(), order.end(),
-            [&](size_t a, size_t b) { return all[per * a] < all[per * b]; });
-  gtag.resize(n);
-  for (auto *v : {&gx, &gy, &gz, &gq, &galpha}) v->resize(n);
-  for (size_t k = 0; k < n; k++) {
-    const double *a = &all[per * order[k]];
-    gtag[k] = (tagint) a[0];
-    gx[k] = a[1];
-    gy[k] = a[2];
-    gz[k] = a[3];
-    gq[k] = a[4];
-    galpha[k] = a[5];
-  }
+  galpha.assign(gathered.size(), 0.0);
+  if (s.polarize)
+    for (size_t k = 0; k < gathered.size(); k++)
+      galpha[k] = gcfmm::polarizability(beta, gathered.extra[k]);
 }
 
 double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool predict)
 {
   gather();
+  const std::vector<tagint> &gtag = gathered.tag;
+  const std::vector<double> &gz = gathered.z;
   const size_t n = gtag.size();
   const int cols = s.polarize ? 7 : 4;    // the fix's per-atom columns
   for (int i = 0; i < atom->nlocal; i++) {
@@ -153,7 +130,7 @@ double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool pre
       solver->set_box(domain->boxlo[0], domain->boxlo[1], domain->xprd, domain->yprd);
       solver->set_z_range(domain->boxlo[2], domain->boxhi[2]);
     }
-    solver->compute(n, gx.data(), gy.data(), gz.data(), gq.data(),
+    solver->compute(n, gathered.x.data(), gathered.y.data(), gz.data(), gathered.q.data(),
                     s.polarize ? galpha.data() : nullptr, gp.data(), out);
   } catch (gcfmm::CoincidentParticles &e) {
     // the solver's sources are the atoms, then (with an electrode) their images
@@ -225,6 +202,7 @@ double CoulFMMPolarizable::p2p() const
 
 double CoulFMMPolarizable::memory_usage() const
 {
-  return (double) (gx.capacity() * 6 + gp.capacity() + last_p.capacity()) * sizeof(double) +
-      (double) (gtag.capacity() + last_tag.capacity()) * sizeof(tagint);
+  return (double) (gathered.x.capacity() * 6 + gp.capacity() + last_p.capacity() + prev_p.capacity()) *
+      sizeof(double) +
+      (double) (gathered.tag.capacity() + last_tag.capacity() + prev_tag.capacity()) * sizeof(tagint);
 }

@@ -18,6 +18,7 @@
 #ifndef LMP_COUL_FMM_POLARIZABLE_H
 #define LMP_COUL_FMM_POLARIZABLE_H
 
+#include "coul_fmm_comm.h"
 #include "pointers.h"
 
 #include <memory>
@@ -71,9 +72,11 @@ class CoulFMMPolarizable : protected Pointers {
   int groupbit;
   std::unique_ptr<gcfmm::PolarizableSolver> solver;
   bool periodic = false;
-  // all atoms of the group, sorted by ID: tag, x, y, z, q, alpha (bare units)
-  std::vector<double> gx, gy, gz, gq, galpha, gp;
-  std::vector<tagint> gtag;
+  // all atoms of the group, sorted by ID (radius as the extra value), their polarizabilities
+  // (bare units) and dipoles
+  std::unique_ptr<CoulFMMComm> mpi;
+  GatheredCharges gathered;
+  std::vector<double> galpha, gp;
   // the last two solutions, by atom ID (sorted), and their steps: the warm start is the last
   // one, or 2 p_n - p_{n-1} after two consecutive steps (a linear prediction)
   std::vector<tagint> last_tag, prev_tag;
