@@ -20,6 +20,7 @@
 
 #include "gcfmm/dipole_kernels.hpp"
 #include "gcfmm/far_field.hpp"
+#include "gcfmm/near_pair_change.hpp"
 #include "gcfmm/polarizable_solver.hpp"
 #include "gcfmm/solver.hpp"
 
@@ -78,6 +79,7 @@ void CoulFMMPolarizable::init(const gcfmm::Options &opts)
   // LAMMPS field units (force = qe2f q E) -> bare units (force = qqrd2e q E_bare)
   const double to_bare = force->qe2f / force->qqrd2e;
   env.applied_field = {to_bare * s.field[0], to_bare * s.field[1], to_bare * s.field[2]};
+  applied = env.applied_field;
   env.electrode = s.electrode;
   env.electrode_z = s.electrode_z;
   solver->set_environment(env);
@@ -99,18 +101,135 @@ void CoulFMMPolarizable::gather()
       galpha[k] = gcfmm::polarizability(beta, gathered.extra[k]);
 }
 
-double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool predict)
+// this rank's atoms of the group and their index in the gathered order (binary search by ID)
+void CoulFMMPolarizable::map_local()
 {
-  gather();
-  const std::vector<tagint> &gtag = gathered.tag;
-  const std::vector<double> &gz = gathered.z;
-  const size_t n = gtag.size();
+  local_i.clear();
+  local_k.clear();
+  for (int i = 0; i < atom->nlocal; i++) {
+    if (!(atom->mask[i] & groupbit)) continue;
+    local_i.push_back(i);
+    local_k.push_back(std::lower_bound(gathered.tag.begin(), gathered.tag.end(), atom->tag[i]) -
+                      gathered.tag.begin());
+  }
+}
+
+// the atom that is not above the electrode (every rank sees the same gathered atoms)
+std::string CoulFMMPolarizable::below_electrode() const
+{
+  for (size_t k = 0; k < gathered.size(); k++)
+    if (s.electrode && !(gathered.z[k] > s.electrode_z))
+      return fmt::format("atom {} (z = {:g}) is not above the electrode (z = {:g})", gathered.tag[k],
+                         gathered.z[k], s.electrode_z);
+  return {};
+}
+
+void CoulFMMPolarizable::set_time_stepping(double cutoff, bool measure_error)
+{
+  near_cutoff = cutoff;
+  measure = measure_error;
+}
+
+// the last evaluation's atoms, with the same charges, continued to their positions now: `then`
+// is where each was at the evaluation, unwrapped alike (now minus its displacement, the
+// nearest periodic copy of it), so that every pair keeps its copy from then to now
+bool CoulFMMPolarizable::continue_last(gcfmm::NearChange &change)
+{
+  const size_t n = gathered.size();
+  if (eval.tag.empty() || eval.tag != gathered.tag || eval.q != gathered.q) return false;
+  const double period[3] = {domain->xprd, domain->yprd, 0.0};
+  now.resize(3 * n);
+  then.resize(3 * n);
+  for (size_t k = 0; k < n; k++) {
+    const double r[3] = {gathered.x[k], gathered.y[k], gathered.z[k]};
+    for (int a = 0; a < 3; a++) {
+      double d = r[a] - eval.x[3 * k + a];
+      if (periodic && a < 2) d -= period[a] * std::round(d / period[a]);
+      now[3 * k + a] = r[a];
+      then[3 * k + a] = r[a] - d;
+    }
+  }
+  if (!near) {
+    change.field.assign(3 * local_k.size(), 0.0);
+    change.pot.assign(local_k.size(), 0.0);
+    change.force.assign(3 * local_k.size(), 0.0);
+    return true;
+  }
+  bool done = false;
+  try {
+    done = near->compute(n, now.data(), then.data(), eval.q.data(), s.polarize ? eval.p.data() : nullptr,
+                         local_k.data(), local_k.size(), change);
+  } catch (std::exception &e) {
+    const std::string below = below_electrode();
+    error->all(FLERR, "Fix coul/fmm: {}", below.empty() ? std::string(e.what()) : below);
+  }
+  return done;
+}
+
+// this rank's outputs from the stored evaluation plus `change` (null: none); returns the energy
+double CoulFMMPolarizable::store(double **field, double **force_out, const gcfmm::NearChange *change)
+{
   const int cols = s.polarize ? 7 : 4;    // the fix's per-atom columns
   for (int i = 0; i < atom->nlocal; i++) {
     for (int k = 0; k < cols; k++) field[i][k] = 0.0;
     for (int k = 0; k < 3; k++) force_out[i][k] = 0.0;
   }
-  if (n == 0) return 0.0;
+  const double c = force->qqrd2e;
+  double energy = 0.0;
+  for (size_t t = 0; t < local_k.size(); t++) {
+    const int i = local_i[t];
+    const size_t k = local_k[t];
+    double u = eval.energy[k];
+    if (change) {
+      // U_i changes by 1/2 q dphi - q E_a . dr with the dipole held (polarizable_energy_term)
+      const gcfmm::Vec3 dr{now[3 * k] - then[3 * k], now[3 * k + 1] - then[3 * k + 1],
+                           now[3 * k + 2] - then[3 * k + 2]};
+      u += gcfmm::polarizable_energy_term(eval.q[k], change->pot[t], applied, dr, gcfmm::Vec3{});
+    }
+    for (int a = 0; a < 3; a++) {
+      field[i][a] = c * (eval.field[3 * k + a] + (change ? change->field[3 * t + a] : 0.0));
+      if (s.polarize) field[i][4 + a] = eval.p[3 * k + a];
+      force_out[i][a] = c * (eval.force[3 * k + a] + (change ? change->force[3 * t + a] : 0.0));
+    }
+    field[i][3] = atom->q[i] != 0.0 ? 2.0 * c * u / atom->q[i] : 0.0;
+    energy += c * u;
+  }
+  return energy;
+}
+
+bool CoulFMMPolarizable::advance(double **field, double **force_out, double &energy)
+{
+  gather();
+  map_local();
+  gcfmm::NearChange change;
+  if (!continue_last(change)) return false;
+  energy = store(field, force_out, &change);
+  return true;
+}
+
+double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool predict)
+{
+  gather();
+  map_local();
+  const std::vector<tagint> &gtag = gathered.tag;
+  const std::vector<double> &gz = gathered.z;
+  const size_t n = gtag.size();
+  // the forces the time stepping would have applied now, to measure its error
+  std::vector<double> predicted;
+  if (measure) {
+    gcfmm::NearChange change;
+    if (continue_last(change)) {
+      predicted.resize(3 * local_k.size());
+      for (size_t t = 0; t < local_k.size(); t++)
+        for (int a = 0; a < 3; a++)
+          predicted[3 * t + a] = eval.force[3 * local_k[t] + a] + change.force[3 * t + a];
+    }
+  }
+  eval.tag.clear();
+  if (n == 0) {
+    last_prediction_error = -1.0;
+    return store(field, force_out, nullptr);
+  }
   // warm start: the last solution of the atoms that are still there (both lists sorted by ID)
   gp.assign(3 * n, 0.0);
   const bigint step = update->ntimestep;
@@ -139,16 +258,11 @@ double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool pre
   } catch (std::exception &e) {
     failure = e.what();
   }
-  // every rank solved the same system, so every rank sees the same failure
+  // every rank solved the same system, so every rank sees the same failure; the solver names
+  // the particle by its index in the sorted list: name the atom instead
   if (!failure.empty()) {
-    // the solver names the particle by its index in the sorted list: name the atom instead
-    for (size_t k = 0; k < n; k++)
-      if (s.electrode && !(gz[k] > s.electrode_z)) {
-        failure = fmt::format("atom {} (z = {:g}) is not above the electrode (z = {:g})", gtag[k],
-                              gz[k], s.electrode_z);
-        break;
-      }
-    error->all(FLERR, "Fix coul/fmm: {}", failure);
+    const std::string below = below_electrode();
+    error->all(FLERR, "Fix coul/fmm: {}", below.empty() ? failure : below);
   }
   const auto &rep = solver->report();
   last_iterations = rep.iterations;
@@ -166,21 +280,44 @@ double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool pre
   last_p = gp;
   last_step = step;
 
-  // this rank's atoms (binary search by ID in the sorted list); bare -> LAMMPS units
-  const double c = force->qqrd2e;
-  double energy = 0.0;
-  for (int i = 0; i < atom->nlocal; i++) {
-    if (!(atom->mask[i] & groupbit)) continue;
-    const size_t k = std::lower_bound(gtag.begin(), gtag.end(), atom->tag[i]) - gtag.begin();
-    for (int a = 0; a < 3; a++) {
-      field[i][a] = c * out.field[3 * k + a];
-      if (s.polarize) field[i][4 + a] = gp[3 * k + a];
-      force_out[i][a] = c * out.force[3 * k + a];
-    }
-    field[i][3] = atom->q[i] != 0.0 ? 2.0 * c * out.energy[k] / atom->q[i] : 0.0;
-    energy += c * out.energy[k];
+  // the evaluation the time stepping continues
+  eval.tag = gtag;
+  eval.q = gathered.q;
+  eval.x.resize(3 * n);
+  for (size_t k = 0; k < n; k++) {
+    eval.x[3 * k] = gathered.x[k];
+    eval.x[3 * k + 1] = gathered.y[k];
+    eval.x[3 * k + 2] = gz[k];
   }
-  return energy;
+  eval.p = gp;
+  eval.field = out.field;
+  eval.force = out.force;
+  eval.energy = out.energy;
+  if (near_cutoff > 0.0) {
+    gcfmm::NearGeometry geo;
+    geo.periodic = periodic;
+    geo.lx = domain->xprd;
+    geo.ly = domain->yprd;
+    geo.electrode = s.electrode;
+    geo.electrode_z = s.electrode_z;
+    near = std::make_unique<gcfmm::NearPairChange>(near_cutoff, geo);
+  }
+
+  // relative RMS of the continued forces against these (eq. (8.2) of doc/polarization.md)
+  last_prediction_error = -1.0;
+  if (measure) {
+    double sums[3] = {0.0, 0.0, predicted.empty() ? 0.0 : 1.0};
+    for (size_t t = 0; t < predicted.size() / 3; t++)
+      for (int a = 0; a < 3; a++) {
+        const double f = out.force[3 * local_k[t] + a];
+        sums[0] += (predicted[3 * t + a] - f) * (predicted[3 * t + a] - f);
+        sums[1] += f * f;
+      }
+    // every rank continued the same evaluation or none (the same gathered atoms)
+    MPI_Allreduce(MPI_IN_PLACE, sums, 3, MPI_DOUBLE, MPI_SUM, world);
+    if (sums[2] > 0.0) last_prediction_error = sums[1] > 0.0 ? std::sqrt(sums[0] / sums[1]) : 0.0;
+  }
+  return store(field, force_out, nullptr);
 }
 
 double CoulFMMPolarizable::estimated_error() const
@@ -202,7 +339,8 @@ double CoulFMMPolarizable::p2p() const
 
 double CoulFMMPolarizable::memory_usage() const
 {
-  return (double) (gathered.x.capacity() * 6 + gp.capacity() + last_p.capacity() + prev_p.capacity()) *
+  return (double) (gathered.x.capacity() * 6 + gp.capacity() + last_p.capacity() + prev_p.capacity() +
+                   eval.x.capacity() * 6 + now.capacity() + then.capacity()) *
       sizeof(double) +
       (double) (gathered.tag.capacity() + last_tag.capacity() + prev_tag.capacity()) * sizeof(tagint);
 }

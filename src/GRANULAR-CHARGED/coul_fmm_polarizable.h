@@ -13,7 +13,9 @@
 // are gathered on every rank (sorted by ID, so that every rank solves the same system); each
 // FMM evaluation is split among the ranks by target and summed, so every rank holds the same
 // fields and dipoles; each keeps its own atoms' results. The dipoles of the last evaluation,
-// kept by atom ID, start the next induction solve.
+// kept by atom ID, start the next induction solve. Between evaluations (fix coul/fmm every,
+// tolerance, near) the last evaluation is continued: its fields and forces plus the change of
+// the near pairs with the dipoles held (gcfmm::NearPairChange; doc/polarization.md, section 8).
 
 #ifndef LMP_COUL_FMM_POLARIZABLE_H
 #define LMP_COUL_FMM_POLARIZABLE_H
@@ -21,12 +23,16 @@
 #include "coul_fmm_comm.h"
 #include "pointers.h"
 
+#include "gcfmm/types.hpp"
+
 #include <memory>
 #include <string>
 #include <vector>
 
 namespace gcfmm {
+class NearPairChange;
 class PolarizableSolver;
+struct NearChange;
 struct Options;
 }    // namespace gcfmm
 
@@ -56,6 +62,17 @@ class CoulFMMPolarizable : protected Pointers {
   // predict: start from the dipoles extrapolated from the last two steps when they were the
   // two steps before this one (false: from the last solution; e.g. in a minimization)
   double evaluate(double **field, double **force, bool predict = true);
+  // the same outputs from the last evaluation continued to the atoms now (its values plus the
+  // near pairs' change within `cutoff` since then, dipoles held; the far part held). False
+  // (nothing written) when it cannot be continued: no evaluation yet, other atoms or charges,
+  // or displacements too large for the periodic cell; the caller then evaluates.
+  bool advance(double **field, double **force, double &energy);
+  // the near cutoff of advance() (0: only the evaluation's values, held) and whether
+  // evaluate() measures the error of the continued forces (the multiple time stepping is on)
+  void set_time_stepping(double cutoff, bool measure);
+  // relative RMS difference of the continued forces from those of the last evaluate() (over
+  // the group's charged and polarizable atoms); -1 if that evaluation continued nothing
+  double prediction_error() const { return last_prediction_error; }
 
   // the solver's error estimate, order, M2L and P2P counts of the last evaluation
   double estimated_error() const;
@@ -85,7 +102,26 @@ class CoulFMMPolarizable : protected Pointers {
   int last_iterations = 0;
   double last_residual = 0.0;
 
+  // the last evaluation, in the gathered order (bare units; positions interleaved, 3 per atom)
+  struct Evaluation {
+    std::vector<tagint> tag;
+    std::vector<double> x, q, p, field, force, energy;
+  } eval;
+  double near_cutoff = 0.0;
+  bool measure = false;
+  double last_prediction_error = -1.0;
+  std::unique_ptr<gcfmm::NearPairChange> near;
+  std::vector<size_t> local_k;    // this rank's group atoms: their index in the gathered order
+  std::vector<int> local_i;       // and their local index
+  std::vector<double> now, then;  // gathered positions now and at the evaluation (3 per atom)
+
+  gcfmm::Vec3 applied;            // the applied field, bare units
+
   void gather();
+  void map_local();
+  bool continue_last(gcfmm::NearChange &change);
+  double store(double **field, double **force, const gcfmm::NearChange *change);
+  std::string below_electrode() const;
 };
 
 }    // namespace LAMMPS_NS

@@ -86,7 +86,7 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
                                                  {"every", &mts.every},
                                                  {"check", &mts.check_every}};
   CoulFMMPolarizable::Settings polar;
-  bool any_polar = false;
+  bool any_polar = false, extrapolate_given = false;
   for (int iarg = 3; iarg < narg;) {
     const std::string key = arg[iarg];
     const bool known = reals.count(key) || integers.count(key) || key == "farfield" ||
@@ -104,6 +104,7 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
       *integers.at(key) = utils::inumeric(FLERR, v, false, lmp);
     } else if (key == "extrapolate") {
       mts.extrapolate = utils::logical(FLERR, v, false, lmp) == 1;
+      extrapolate_given = true;
     } else if (key == "farfield") {
       const gcfmm::FarField fields[] = {gcfmm::FarField::Exact, gcfmm::FarField::Average,
                                         gcfmm::FarField::None};
@@ -139,6 +140,11 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
     iarg += 1 + nvals;
   }
   if (any_polar) {
+    // the polarised time stepping holds the far part (doc/polarization.md, section 8)
+    if (extrapolate_given && mts.extrapolate)
+      error->all(FLERR, "Fix coul/fmm extrapolate yes is not supported with efield, polarize or "
+                 "electrode (the far part is held between evaluations)");
+    mts.extrapolate = false;
     polarizable = std::make_unique<CoulFMMPolarizable>(lmp, polar, groupbit);
     if (polar.polarize) field_cols = 7;
   } else if (polar.tolerance > 0.0) {
@@ -215,13 +221,22 @@ void FixCoulFMM::init()
                    "Fix coul/fmm polarize with fix efield: fix efield's field would not "
                    "polarize the particles; give it to fix coul/fmm efield instead");
     }
+    // the multiple time stepping of doc/polarization.md, section 8: the near pairs' change
+    // with the dipoles held, the far part held (no extrapolation), no keyword check
     const auto &mts = stepping->settings();
-    if ((mts.every > 1 || mts.near_cutoff > 0.0) && comm->me == 0)
+    if (mts.check_every > 0 && comm->me == 0)
       error->warning(FLERR,
-                     "Fix coul/fmm {}: with efield, polarize or electrode every step is an "
-                     "evaluation (every, tolerance, near and extrapolate are ignored)",
+                     "Fix coul/fmm {}: check is ignored with efield, polarize or electrode (the "
+                     "error of the time stepping is measured at every evaluation, vector element 9)",
                      id);
+    const double half_cell = 0.5 * MIN(domain->xprd, domain->yprd);
+    if (opts->boundary == gcfmm::Boundary::Periodic2D && mts.every > 1 && mts.near_cutoff >= half_cell)
+      error->all(FLERR,
+                 "Fix coul/fmm near {:g} with efield, polarize or electrode must be smaller than "
+                 "half the periodic cell ({:g})",
+                 mts.near_cutoff, half_cell);
     polarizable->init(*opts);
+    polarizable->set_time_stepping(mts.every > 1 ? mts.near_cutoff : 0.0, mts.every > 1);
     return;
   }
   evaluator->init(
@@ -280,7 +295,8 @@ void FixCoulFMM::setup(int vflag)
   // continue the schedule of the previous run (or of the restart file) when its stored field
   // still belongs to these atoms, charges and box: a run split into pieces, or continued from
   // a restart, then evaluates on the same steps as the uninterrupted run
-  if (!polarizable && !evaluator->continues(*stepping, eval_state)) stepping->restart_schedule();
+  // (with efield, polarize or electrode: an evaluation at every setup)
+  if (polarizable || !evaluator->continues(*stepping, eval_state)) stepping->restart_schedule();
   if (utils::strmatch(update->integrate_style, "^verlet")) {
     post_force(vflag);
   } else {
@@ -427,12 +443,22 @@ void FixCoulFMM::add_force(int i, const double *fi, bool in_plane)
 }
 
 // efield, polarize, electrode: F_i = q_i E_i + (p_i . grad) E_i and the energy of
-// doc/polarization.md, eq. (3.4), evaluated every step; virial as in apply_field()
+// doc/polarization.md, eq. (3.4), evaluated on the schedule's steps and continued between them
+// (section 8); a minimizer's call (predict false) always evaluates; virial as in apply_field()
 void FixCoulFMM::post_force_polarizable(bool predict)
 {
-  energy_local = polarizable->evaluate(field, polar_force, predict);
+  const bigint step = update->ntimestep;
+  const bool continued = predict && !stepping->scheduled(step) &&
+      polarizable->advance(field, polar_force, energy_local);
+  if (!continued) {
+    energy_local = polarizable->evaluate(field, polar_force, predict);
+    nevaluations++;
+    if (predict) {
+      if (polarizable->prediction_error() >= 0.0) stepping->adapt(polarizable->prediction_error());
+      stepping->evaluated.step = step;
+    }
+  }
   energy_summed = false;
-  nevaluations++;
   const bool in_plane = opts->boundary != gcfmm::Boundary::Periodic2D;
   for (int i = 0; i < atom->nlocal; i++)
     if (atom->mask[i] & groupbit) add_force(i, polar_force[i], in_plane);

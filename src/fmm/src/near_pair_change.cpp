@@ -1,5 +1,5 @@
 // GRANULAR-CHARGED FMM core library (gcfmm): the near pairs' change between evaluations
-// (near_pair_change.hpp; doc/polarization.md, section 9).
+// (near_pair_change.hpp; doc/polarization.md, section 8).
 #include "gcfmm/near_pair_change.hpp"
 
 #include <algorithm>

@@ -1,5 +1,5 @@
 // GRANULAR-CHARGED FMM core library (gcfmm).
-// The multiple time stepping of polarizable particles (doc/polarization.md, section 9): between
+// The multiple time stepping of polarizable particles (doc/polarization.md, section 8): between
 // two FMM evaluations the force on each particle is the evaluation's plus the change of its near
 // pairs since then, with the charges and dipoles held at the evaluation's values:
 //   F_i(t) = F_i(t_e) + sum_{k near i} [f_ik(t) - f_ik(t_e)],   f_ik = q_i E_k(r_i) + G_k(r_i) p_i
