@@ -57,6 +57,27 @@ def conventions(snap: packing.Snapshot, rp: float) -> dict:
     }
 
 
+ORIENTATION_BINS = 10   # bins of |cos theta| in [0, 1]
+
+
+def contact_orientation(snap: packing.Snapshot, zlo: float | None = None,
+                        zhi: float | None = None) -> dict:
+    """Directions of the geometric contacts against the z axis (the applied field of an
+    electrophoretic deposition, doc/epd.md), of the contacts whose midpoint lies in [zlo, zhi]
+    (default: all): the order parameter S = <3 cos^2 theta - 1> / 2 (isotropic 0, all along z
+    1, all across -1/2), the mean |cos theta| (isotropic 1/2) and the histogram of |cos theta|
+    (isotropic: uniform, density 1)."""
+    pairs, n = packing.contact_normals(snap)
+    zmid = 0.5 * (snap["z"][pairs[:, 0]] + snap["z"][pairs[:, 1]]) if len(pairs) else np.zeros(0)
+    keep = (zmid >= (-np.inf if zlo is None else zlo)) & (zmid <= (np.inf if zhi is None else zhi))
+    c = np.abs(n[keep, 2])
+    hist, _ = np.histogram(c, bins=ORIENTATION_BINS, range=(0.0, 1.0), density=True)
+    return {"contacts": int(len(c)),
+            "S": float(np.mean(1.5 * c * c - 0.5)) if len(c) else float("nan"),
+            "mean_abs_cos": float(c.mean()) if len(c) else float("nan"),
+            "abs_cos_hist": hist.tolist() if len(c) else [float("nan")] * ORIENTATION_BINS}
+
+
 def fz_populations(fZ) -> dict:
     """Shares of Z = 1-2 and Z = 4-6 in f(Z) (bins Z = 0, 1, ...)."""
     f = np.asarray(fZ, dtype=float)

@@ -175,16 +175,22 @@ def periodic_tree(snap: Snapshot, rcut: float):
     return cKDTree(xyz, boxsize=[snap.lx, snap.ly, bz]), xyz
 
 
-def pair_distances(snap: Snapshot, rcut: float):
-    """All pairs (i < j, indices into the snapshot) with r_ij <= rcut, with distances (x, y
-    periodic by the minimum image, z open)."""
+def pair_vectors(snap: Snapshot, rcut: float):
+    """All pairs (i < j, indices into the snapshot) with r_ij <= rcut, with their separations
+    r_i - r_j (x, y periodic by the minimum image, z open; one row per pair)."""
     tree, xyz = periodic_tree(snap, rcut)
     pairs = tree.query_pairs(rcut, output_type="ndarray")
     if len(pairs) == 0:
-        return pairs.reshape(0, 2), np.zeros(0)
+        return pairs.reshape(0, 2), np.zeros((0, 3))
     d = xyz[pairs[:, 0]] - xyz[pairs[:, 1]]
     d[:, 0] -= snap.lx * np.round(d[:, 0] / snap.lx)
     d[:, 1] -= snap.ly * np.round(d[:, 1] / snap.ly)
+    return pairs, d
+
+
+def pair_distances(snap: Snapshot, rcut: float):
+    """All pairs (i < j) with r_ij <= rcut, with distances (pair_vectors)."""
+    pairs, d = pair_vectors(snap, rcut)
     return pairs, np.sqrt((d * d).sum(axis=1))
 
 
@@ -199,6 +205,18 @@ def contacts(snap: Snapshot, tol: float = 0.0):
     ov = rad[pairs[:, 0]] + rad[pairs[:, 1]] - dist
     keep = ov >= -tol
     return pairs[keep], ov[keep]
+
+
+def contact_normals(snap: Snapshot, tol: float = 0.0):
+    """The geometric contacts of contacts() with unit vectors along them (from j to i; the sign
+    carries no meaning): (pairs, normals), one row per contact."""
+    rad = snap["radius"]
+    pairs, d = pair_vectors(snap, 2.0 * rad.max() + tol)
+    if len(pairs) == 0:
+        return pairs, d
+    dist = np.sqrt((d * d).sum(axis=1))
+    keep = rad[pairs[:, 0]] + rad[pairs[:, 1]] - dist >= -tol
+    return pairs[keep], d[keep] / dist[keep, None]
 
 
 def coordination(snap: Snapshot, tol: float = 0.0) -> np.ndarray:

@@ -53,3 +53,44 @@ def test_conventions_on_a_square_layer():
     for k in ("phi_bed_top", "phi_bed_2z", "phi_bed_surface"):
         assert c[k] == pytest.approx(want), k
     assert c["Z_all"] == pytest.approx(4.0) and c["Z_all_floor"] == pytest.approx(5.0)
+
+
+def test_contact_orientation_of_columns_and_layers():
+    # a square layer of touching spheres (every contact across z: |cos| = 0, S = -1/2), then
+    # the same with a second layer stacked on top (16 vertical contacts added to the 32
+    # periodic in-plane ones of each layer: S = (16 x 1 + 64 x -1/2) / 80 = -0.2); the midpoint
+    # window keeps only the vertical contacts between the layers (S = 1)
+    xs = np.arange(4) * 2.0 + 1.0
+    x, y = np.meshgrid(xs, xs)
+    n = x.size
+    box = np.array([[0, 8], [0, 8], [0, 10]], float)
+    one = packing.Snapshot(0, box, {"id": np.arange(1, n + 1), "x": x.ravel(), "y": y.ravel(),
+                                    "z": np.ones(n), "radius": np.ones(n)})
+    o = measures.contact_orientation(one)
+    assert o["contacts"] == 32 and o["S"] == pytest.approx(-0.5) and o["mean_abs_cos"] == pytest.approx(0.0)
+    two = packing.Snapshot(0, box, {"id": np.arange(1, 2 * n + 1), "x": np.tile(x.ravel(), 2),
+                                    "y": np.tile(y.ravel(), 2),
+                                    "z": np.concatenate([np.ones(n), 3 * np.ones(n)]),
+                                    "radius": np.ones(2 * n)})
+    o = measures.contact_orientation(two)
+    assert o["contacts"] == 80 and o["S"] == pytest.approx(-0.2)
+    v = measures.contact_orientation(two, zlo=1.5, zhi=2.5)
+    assert v["contacts"] == 16 and v["S"] == pytest.approx(1.0)
+    assert v["abs_cos_hist"][-1] == pytest.approx(measures.ORIENTATION_BINS)
+
+
+def test_contact_orientation_is_zero_for_isotropic_contacts():
+    # 4000 random directions, each a (slightly overlapping) pair far from the others: S = 0 and mean |cos| =
+    # 1/2 within their sampling error (sd of S 0.45 / sqrt(4000) = 0.007: 5 sd)
+    rng = np.random.default_rng(3)
+    v = rng.normal(size=(4000, 3))
+    v /= np.linalg.norm(v, axis=1)[:, None]
+    centres = np.column_stack([(np.arange(4000) % 40) * 10.0 + 5, (np.arange(4000) // 40 % 10) * 10.0 + 5,
+                               (np.arange(4000) // 400) * 10.0 + 5])
+    xyz = np.concatenate([centres, centres + 1.999 * v])
+    box = np.array([[0, 400], [0, 100], [0, 200]], float)
+    snap = packing.Snapshot(0, box, {"id": np.arange(1, 8001), "x": xyz[:, 0], "y": xyz[:, 1],
+                                     "z": xyz[:, 2], "radius": np.ones(8000)})
+    o = measures.contact_orientation(snap)
+    assert o["contacts"] == 4000
+    assert abs(o["S"]) < 0.035 and o["mean_abs_cos"] == pytest.approx(0.5, abs=0.025)

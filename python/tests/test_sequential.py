@@ -95,9 +95,14 @@ def test_plane_without_a_free_place_ends_with_a_warning(cli, tmp_path):
 
 def test_epd_variables_give_fix_coul_fmm_its_keywords(cli, tmp_path):
     """E0, eps_p and electrode (doc/epd.md) reach fix coul/fmm as efield 0 0 -E0, polarize eps_p
-    and electrode 0.0, its multiple time stepping left out; the deposition runs to the end."""
+    and electrode 0.0, with the multiple time stepping (doc/polarization.md, section 8) but no
+    check; the deposition runs to the end, with fewer evaluations than steps."""
     res, log = _run(cli, tmp_path, 400, "--var", "E0", "1e5", "--var", "eps_p", 3.8, "--var", "electrode", "yes",
                     size=["--N", 4, "--seed", 1, "--var", "L_rp", 6, "--var", "H_rp", 20, "--no-render"])
-    assert re.search(r"^fix coul all coul/fmm accuracy 1e-4 farfield exact images 1 efield 0 0 -100000 "
-                     r"polarize 3.8 electrode 0.0\s*$", log, re.M)
+    assert re.search(r"^fix coul all coul/fmm accuracy 1e-4 farfield exact images 1 every 1024 near \S+ "
+                     r"extrapolate yes tolerance 2e-4 efield 0 0 -100000 polarize 3.8 electrode 0.0\s*$",
+                     log, re.M)
     assert res["inserted"] == 4 and res["natoms"] == 4 and res["lost"] == 0
+    evaluations = float(re.search(r"^GC COUL evaluations (\S+)", log, re.M).group(1))
+    steps = float(re.search(r"^GC RESULT steps (\S+)", log, re.M).group(1))
+    assert 4 <= evaluations < steps / 2

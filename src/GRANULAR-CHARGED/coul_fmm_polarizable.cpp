@@ -124,16 +124,17 @@ std::string CoulFMMPolarizable::below_electrode() const
   return {};
 }
 
-void CoulFMMPolarizable::set_time_stepping(double cutoff, bool measure_error)
+void CoulFMMPolarizable::set_time_stepping(double cutoff, bool measure_error, bool extrapolate_far)
 {
   near_cutoff = cutoff;
   measure = measure_error;
+  extrapolate = extrapolate_far;
 }
 
 // the last evaluation's atoms, with the same charges, continued to their positions now: `then`
 // is where each was at the evaluation, unwrapped alike (now minus its displacement, the
 // nearest periodic copy of it), so that every pair keeps its copy from then to now
-bool CoulFMMPolarizable::continue_last(gcfmm::NearChange &change)
+bool CoulFMMPolarizable::continue_last(gcfmm::NearChange &change, const std::vector<size_t> &targets)
 {
   const size_t n = gathered.size();
   if (eval.tag.empty() || eval.tag != gathered.tag || eval.q != gathered.q) return false;
@@ -150,15 +151,15 @@ bool CoulFMMPolarizable::continue_last(gcfmm::NearChange &change)
     }
   }
   if (!near) {
-    change.field.assign(3 * local_k.size(), 0.0);
-    change.pot.assign(local_k.size(), 0.0);
-    change.force.assign(3 * local_k.size(), 0.0);
+    change.field.assign(3 * targets.size(), 0.0);
+    change.pot.assign(targets.size(), 0.0);
+    change.force.assign(3 * targets.size(), 0.0);
     return true;
   }
   bool done = false;
   try {
     done = near->compute(n, now.data(), then.data(), eval.q.data(), s.polarize ? eval.p.data() : nullptr,
-                         local_k.data(), local_k.size(), change);
+                         targets.data(), targets.size(), change);
   } catch (std::exception &e) {
     const std::string below = below_electrode();
     error->all(FLERR, "Fix coul/fmm: {}", below.empty() ? std::string(e.what()) : below);
@@ -167,7 +168,8 @@ bool CoulFMMPolarizable::continue_last(gcfmm::NearChange &change)
 }
 
 // this rank's outputs from the stored evaluation plus `change` (null: none); returns the energy
-double CoulFMMPolarizable::store(double **field, double **force_out, const gcfmm::NearChange *change)
+double CoulFMMPolarizable::store(double **field, double **force_out, const gcfmm::NearChange *change,
+                                 double steps)
 {
   const int cols = s.polarize ? 7 : 4;    // the fix's per-atom columns
   for (int i = 0; i < atom->nlocal; i++) {
@@ -189,7 +191,8 @@ double CoulFMMPolarizable::store(double **field, double **force_out, const gcfmm
     for (int a = 0; a < 3; a++) {
       field[i][a] = c * (eval.field[3 * k + a] + (change ? change->field[3 * t + a] : 0.0));
       if (s.polarize) field[i][4 + a] = eval.p[3 * k + a];
-      force_out[i][a] = c * (eval.force[3 * k + a] + (change ? change->force[3 * t + a] : 0.0));
+      force_out[i][a] = c * (eval.force[3 * k + a] + (change ? change->force[3 * t + a] : 0.0) +
+                             steps * eval.slope[3 * k + a]);
     }
     field[i][3] = atom->q[i] != 0.0 ? 2.0 * c * u / atom->q[i] : 0.0;
     energy += c * u;
@@ -202,37 +205,39 @@ bool CoulFMMPolarizable::advance(double **field, double **force_out, double &ene
   gather();
   map_local();
   gcfmm::NearChange change;
-  if (!continue_last(change)) return false;
-  energy = store(field, force_out, &change);
+  if (!continue_last(change, local_k)) return false;
+  energy = store(field, force_out, &change, extrapolate ? (double) (update->ntimestep - eval.step) : 0.0);
   return true;
 }
 
-double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool predict)
+double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool predict, int stride)
 {
   gather();
   map_local();
   const std::vector<tagint> &gtag = gathered.tag;
   const std::vector<double> &gz = gathered.z;
   const size_t n = gtag.size();
-  // the forces the time stepping would have applied now, to measure its error
-  std::vector<double> predicted;
+  // every atom's force the time stepping would have applied now without (held) and with the
+  // far part's trend, to measure its error and to take the next trend (every rank alike)
+  std::vector<double> held;
+  const bigint step = update->ntimestep;
+  const double steps = (double) (step - eval.step);
   if (measure) {
     gcfmm::NearChange change;
-    if (continue_last(change)) {
-      predicted.resize(3 * local_k.size());
-      for (size_t t = 0; t < local_k.size(); t++)
-        for (int a = 0; a < 3; a++)
-          predicted[3 * t + a] = eval.force[3 * local_k[t] + a] + change.force[3 * t + a];
+    all_k.resize(n);
+    std::iota(all_k.begin(), all_k.end(), size_t(0));
+    if (continue_last(change, all_k)) {
+      held.resize(3 * n);
+      for (size_t k = 0; k < 3 * n; k++) held[k] = eval.force[k] + change.force[k];
     }
   }
   eval.tag.clear();
   if (n == 0) {
     last_prediction_error = -1.0;
-    return store(field, force_out, nullptr);
+    return store(field, force_out, nullptr, 0.0);
   }
   // warm start: the last solution of the atoms that are still there (both lists sorted by ID)
   gp.assign(3 * n, 0.0);
-  const bigint step = update->ntimestep;
   const bool linear = predict && last_step == step - 1 && prev_step == step - 2;
   for (size_t k = 0, m = 0, l = 0; k < n && m < last_tag.size(); k++) {
     while (m < last_tag.size() && last_tag[m] < gtag[k]) m++;
@@ -303,21 +308,28 @@ double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool pre
     near = std::make_unique<gcfmm::NearPairChange>(near_cutoff, geo);
   }
 
-  // relative RMS of the continued forces against these (eq. (8.2) of doc/polarization.md)
+  // relative RMS of the continued forces (trend included) against these (eq. (8.2) of
+  // doc/polarization.md); the new trend of the far part, eq. (8.3), from a whole interval (a
+  // shorter one, after an insertion, would stretch the solver's own error between the two
+  // evaluations over a longer one: the old trend is kept)
   last_prediction_error = -1.0;
-  if (measure) {
-    double sums[3] = {0.0, 0.0, predicted.empty() ? 0.0 : 1.0};
-    for (size_t t = 0; t < predicted.size() / 3; t++)
-      for (int a = 0; a < 3; a++) {
-        const double f = out.force[3 * local_k[t] + a];
-        sums[0] += (predicted[3 * t + a] - f) * (predicted[3 * t + a] - f);
-        sums[1] += f * f;
-      }
-    // every rank continued the same evaluation or none (the same gathered atoms)
-    MPI_Allreduce(MPI_IN_PLACE, sums, 3, MPI_DOUBLE, MPI_SUM, world);
-    if (sums[2] > 0.0) last_prediction_error = sums[1] > 0.0 ? std::sqrt(sums[0] / sums[1]) : 0.0;
+  if (held.empty()) {
+    eval.slope.assign(3 * n, 0.0);
+  } else {
+    double sums[2] = {0.0, 0.0};
+    for (size_t k = 0; k < 3 * n; k++) {
+      const double predicted = held[k] + (extrapolate ? steps * eval.slope[k] : 0.0);
+      sums[0] += (predicted - out.force[k]) * (predicted - out.force[k]);
+      sums[1] += out.force[k] * out.force[k];
+    }
+    last_prediction_error = sums[1] > 0.0 ? std::sqrt(sums[0] / sums[1]) : 0.0;
+    if (!extrapolate)
+      eval.slope.assign(3 * n, 0.0);
+    else if (steps >= stride)
+      for (size_t k = 0; k < 3 * n; k++) eval.slope[k] = (out.force[k] - held[k]) / steps;
   }
-  return store(field, force_out, nullptr);
+  eval.step = step;
+  return store(field, force_out, nullptr, 0.0);
 }
 
 double CoulFMMPolarizable::estimated_error() const

@@ -61,15 +61,18 @@ class CoulFMMPolarizable : protected Pointers {
   // LAMMPS units, zero outside the group; returns this rank's part of the energy
   // predict: start from the dipoles extrapolated from the last two steps when they were the
   // two steps before this one (false: from the last solution; e.g. in a minimization)
-  double evaluate(double **field, double **force, bool predict = true);
+  // stride: the time stepping's interval now (a trend of the far part is taken only over at
+  // least that many steps)
+  double evaluate(double **field, double **force, bool predict = true, int stride = 1);
   // the same outputs from the last evaluation continued to the atoms now (its values plus the
   // near pairs' change within `cutoff` since then, dipoles held; the far part held). False
   // (nothing written) when it cannot be continued: no evaluation yet, other atoms or charges,
   // or displacements too large for the periodic cell; the caller then evaluates.
   bool advance(double **field, double **force, double &energy);
-  // the near cutoff of advance() (0: only the evaluation's values, held) and whether
-  // evaluate() measures the error of the continued forces (the multiple time stepping is on)
-  void set_time_stepping(double cutoff, bool measure);
+  // the near cutoff of advance() (0: only the evaluation's values, held), whether evaluate()
+  // measures the error of the continued forces (the multiple time stepping is on), and whether
+  // the far part of the force follows its trend over the last interval (extrapolate)
+  void set_time_stepping(double cutoff, bool measure, bool extrapolate);
   // relative RMS difference of the continued forces from those of the last evaluate() (over
   // the group's charged and polarizable atoms); -1 if that evaluation continued nothing
   double prediction_error() const { return last_prediction_error; }
@@ -106,9 +109,12 @@ class CoulFMMPolarizable : protected Pointers {
   struct Evaluation {
     std::vector<tagint> tag;
     std::vector<double> x, q, p, field, force, energy;
+    std::vector<double> slope;    // trend of the far part of the force per step (eq. (8.3))
+    bigint step = -1;
   } eval;
   double near_cutoff = 0.0;
-  bool measure = false;
+  bool measure = false, extrapolate = false;
+  std::vector<size_t> all_k;      // 0 .. n - 1: every gathered atom as a target
   double last_prediction_error = -1.0;
   std::unique_ptr<gcfmm::NearPairChange> near;
   std::vector<size_t> local_k;    // this rank's group atoms: their index in the gathered order
@@ -119,8 +125,8 @@ class CoulFMMPolarizable : protected Pointers {
 
   void gather();
   void map_local();
-  bool continue_last(gcfmm::NearChange &change);
-  double store(double **field, double **force, const gcfmm::NearChange *change);
+  bool continue_last(gcfmm::NearChange &change, const std::vector<size_t> &targets);
+  double store(double **field, double **force, const gcfmm::NearChange *change, double steps);
   std::string below_electrode() const;
 };
 

@@ -86,7 +86,7 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
                                                  {"every", &mts.every},
                                                  {"check", &mts.check_every}};
   CoulFMMPolarizable::Settings polar;
-  bool any_polar = false, extrapolate_given = false;
+  bool any_polar = false;
   for (int iarg = 3; iarg < narg;) {
     const std::string key = arg[iarg];
     const bool known = reals.count(key) || integers.count(key) || key == "farfield" ||
@@ -104,7 +104,6 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
       *integers.at(key) = utils::inumeric(FLERR, v, false, lmp);
     } else if (key == "extrapolate") {
       mts.extrapolate = utils::logical(FLERR, v, false, lmp) == 1;
-      extrapolate_given = true;
     } else if (key == "farfield") {
       const gcfmm::FarField fields[] = {gcfmm::FarField::Exact, gcfmm::FarField::Average,
                                         gcfmm::FarField::None};
@@ -140,11 +139,6 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
     iarg += 1 + nvals;
   }
   if (any_polar) {
-    // the polarised time stepping holds the far part (doc/polarization.md, section 8)
-    if (extrapolate_given && mts.extrapolate)
-      error->all(FLERR, "Fix coul/fmm extrapolate yes is not supported with efield, polarize or "
-                 "electrode (the far part is held between evaluations)");
-    mts.extrapolate = false;
     polarizable = std::make_unique<CoulFMMPolarizable>(lmp, polar, groupbit);
     if (polar.polarize) field_cols = 7;
   } else if (polar.tolerance > 0.0) {
@@ -222,7 +216,7 @@ void FixCoulFMM::init()
                    "polarize the particles; give it to fix coul/fmm efield instead");
     }
     // the multiple time stepping of doc/polarization.md, section 8: the near pairs' change
-    // with the dipoles held, the far part held (no extrapolation), no keyword check
+    // with the dipoles held, the far part extrapolated (or held), no keyword check
     const auto &mts = stepping->settings();
     if (mts.check_every > 0 && comm->me == 0)
       error->warning(FLERR,
@@ -236,7 +230,8 @@ void FixCoulFMM::init()
                  "half the periodic cell ({:g})",
                  mts.near_cutoff, half_cell);
     polarizable->init(*opts);
-    polarizable->set_time_stepping(mts.every > 1 ? mts.near_cutoff : 0.0, mts.every > 1);
+    polarizable->set_time_stepping(mts.every > 1 ? mts.near_cutoff : 0.0, mts.every > 1,
+                                   mts.every > 1 && mts.extrapolate);
     return;
   }
   evaluator->init(
@@ -451,7 +446,7 @@ void FixCoulFMM::post_force_polarizable(bool predict)
   const bool continued = predict && !stepping->scheduled(step) &&
       polarizable->advance(field, polar_force, energy_local);
   if (!continued) {
-    energy_local = polarizable->evaluate(field, polar_force, predict);
+    energy_local = polarizable->evaluate(field, polar_force, predict, stepping->stride());
     nevaluations++;
     if (predict) {
       if (polarizable->prediction_error() >= 0.0) stepping->adapt(polarizable->prediction_error());

@@ -20,7 +20,8 @@ std::vector<std::size_t> all_targets(std::size_t n) {
 }
 
 // Brute force: every other particle and its copies (i lx, j ly) with |i|, |j| <= 2, and every
-// image (with its copies), near when closer than rc at either end; built from add_charge,
+// image (with its copies), near when closer than rc at either end (a particle's own image at
+// any height); built from add_charge,
 // add_dipole and point_force directly, without cells or minimum images.
 NearChange brute_force(std::size_t n, const std::vector<double> &now, const std::vector<double> &then,
                        const std::vector<double> &q, const std::vector<double> *p, double rc, const NearGeometry &g) {
@@ -50,7 +51,8 @@ NearChange brute_force(std::size_t n, const std::vector<double> &now, const std:
               ps = image_dipole(ps);
             }
             const Vec3 dn = ri - (sn + shift), dt = ri_t - (st + shift);
-            if (!(norm2(dn) < rc * rc || norm2(dt) < rc * rc)) continue;
+            const bool own_image = j == i && image && cx == 0 && cy == 0;    // near at any height
+            if (!own_image && !(norm2(dn) < rc * rc || norm2(dt) < rc * rc)) continue;
             add_charge(qs, dn, fn);
             add_charge(qs, dt, ft);
             if (p) {
@@ -97,6 +99,11 @@ TEST(NearPairChange, ImageForceOfOneCharge) {
   EXPECT_NEAR(out.force[1], 0.0, 1e-15);
   // potential of the image -q at 2 h
   EXPECT_NEAR(out.pot[0], -q / (2 * h2) + q / (2 * h1), 1e-14);
+  // its own image counts at any height: the same change with a cutoff below 2 h at both ends
+  NearPairChange short_near(0.5, g);
+  NearChange out2;
+  ASSERT_TRUE(short_near.compute(1, now.data(), then.data(), qs.data(), nullptr, &t, 1, out2));
+  EXPECT_EQ(out2.force[2], out.force[2]);
 }
 
 // a pair entering the cutoff is counted with both ends (no jump): Coulomb's law

@@ -321,7 +321,6 @@ TEST(CoulFMMPolarize, BadInput)
   expect_match(with(sph, "fix fmm all coul/fmm polarize 4 farfield average"), "need farfield exact or none");
   expect_match(with(sph, "fix fmm all coul/fmm efield 0 0 1", "5", "fix ef all efield 0 0 1"), "would both apply the field");
   expect_match(with(sph, "fix fmm all coul/fmm polarize 4", "5", "fix ef all efield 0 0 1"), "would not polarize the particles");
-  expect_match(with(sph, "fix fmm all coul/fmm polarize 4 every 4 extrapolate yes"), "extrapolate yes is not supported");
   expect_match(with(sph, "fix fmm all coul/fmm polarize 4 every 4 near 5"), "near 5 .* must be smaller than half the periodic cell \\(5\\)");
 }
 
@@ -361,8 +360,8 @@ TEST(CoulFMMPolarize, TimeSteppingWithEveryPairNearIsExact)
 {
   const std::string base = "fix fmm all coul/fmm accuracy 1e-10 efield 0 0 -0.3 electrode 0.5";
   const Moved every = moving("f f f", base, 28);
-  const Moved near = moving("f f f", base + " every 8 near 100", 28);
-  const Moved held = moving("f f f", base + " every 8", 28);
+  const Moved near = moving("f f f", base + " every 8 near 100 extrapolate no", 28);
+  const Moved held = moving("f f f", base + " every 8 extrapolate no", 28);
   EXPECT_EQ(every.evaluations, 29.0);    // setup and each step
   EXPECT_EQ(near.evaluations, 4.0);      // setup, steps 8, 16, 24
   const double near_error = rel_rms(near.f, every.f), held_error = rel_rms(held.f, every.f);
@@ -382,14 +381,24 @@ TEST(CoulFMMPolarize, TimeSteppingWithDipoles)
 {
   const std::string base = "fix fmm all coul/fmm accuracy 1e-6 polarize 3.8 efield 0 0 -0.3 electrode 0.5";
   const Moved every = moving("f f f", base, 28);
-  const Moved near = moving("f f f", base + " every 8 near 100", 28);
-  const Moved held = moving("f f f", base + " every 8", 28);
+  const Moved near = moving("f f f", base + " every 8 near 100 extrapolate no", 28);
+  const Moved held = moving("f f f", base + " every 8 extrapolate no", 28);
   const double near_error = rel_rms(near.f, every.f), held_error = rel_rms(held.f, every.f);
   std::printf("[ mts ] dipoles, every 8: all near: %.3g (estimate %.3g); held: %.3g (estimate %.3g)\n",
               near_error, near.estimate, held_error, held.estimate);
   EXPECT_LT(near_error, 0.3 * held_error);
   EXPECT_GT(near.estimate, 0.0);
   EXPECT_LT(near.estimate, 0.3 * held.estimate);
+  // p p f, near pairs within 4 (most pairs far): the far part's trend over the last interval
+  // (extrapolate, eq. (8.3)) takes out most of what the held far part leaves
+  const Moved every_p = moving("p p f", base, 28);
+  const Moved trend = moving("p p f", base + " every 8 near 4", 28);
+  const Moved flat = moving("p p f", base + " every 8 near 4 extrapolate no", 28);
+  const double trend_error = rel_rms(trend.f, every_p.f), flat_error = rel_rms(flat.f, every_p.f);
+  std::printf("[ mts ] p p f, every 8 near 4: extrapolated %.3g (estimate %.3g); held far part %.3g "
+              "(estimate %.3g)\n", trend_error, trend.estimate, flat_error, flat.estimate);
+  EXPECT_LT(trend_error, 0.5 * flat_error);
+  EXPECT_LT(trend.estimate, 0.5 * flat.estimate);
   // a loose tolerance lets the interval grow; one below what an interval of 2 reaches keeps it
   // at 1 (every step evaluated)
   const Moved loose = moving("f f f", base + " every 16 tolerance 2e-3 near 100", 64);

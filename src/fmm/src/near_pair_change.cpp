@@ -44,6 +44,20 @@ FieldTerms<double> source_terms(const double q, const double *p, const double d[
   return t;
 }
 
+// diff += a - b, term by term: per pair, now minus then (the small change of two large terms)
+void add_change(const FieldTerms<double> &a, const FieldTerms<double> &b, FieldTerms<double> &diff) {
+  diff.pot += a.pot - b.pot;
+  diff.ex += a.ex - b.ex;
+  diff.ey += a.ey - b.ey;
+  diff.ez += a.ez - b.ez;
+  diff.gxx += a.gxx - b.gxx;
+  diff.gxy += a.gxy - b.gxy;
+  diff.gxz += a.gxz - b.gxz;
+  diff.gyy += a.gyy - b.gyy;
+  diff.gyz += a.gyz - b.gyz;
+  diff.gzz += a.gzz - b.gzz;
+}
+
 }  // namespace
 
 NearPairChange::NearPairChange(double cutoff, const NearGeometry &geometry) : cutoff_(cutoff), geo_(geometry) {
@@ -162,7 +176,7 @@ bool NearPairChange::compute(std::size_t n, const double *now, const double *the
           const std::size_t cell = ((std::size_t) nb[2][cz] * cells[1] + nb[1][cy]) * cells[0] + nb[0][cx];
           for (std::size_t it = cell_start_[cell]; it < cell_start_[cell + 1]; ++it) {
             const Source &s = sources_[cell_items_[it]];
-            if (!s.image && s.particle == i) continue;
+            if (s.particle == i) continue;    // itself; its own image is added below
             double dn[3], dt[3];
             for (int a = 0; a < 3; ++a) dn[a] = ri[a] - s.now[a];
             // the copy of the source nearest now, the same copy then
@@ -182,19 +196,21 @@ bool NearPairChange::compute(std::size_t n, const double *now, const double *the
             const double *sp = p ? s.p : nullptr;
             const FieldTerms<double> a = source_terms(s.q, sp, dn, gradient);
             const FieldTerms<double> b = source_terms(s.q, sp, dt, gradient);
-            // per pair, now minus then (the small change of two large terms)
-            diff.pot += a.pot - b.pot;
-            diff.ex += a.ex - b.ex;
-            diff.ey += a.ey - b.ey;
-            diff.ez += a.ez - b.ez;
-            diff.gxx += a.gxx - b.gxx;
-            diff.gxy += a.gxy - b.gxy;
-            diff.gxz += a.gxz - b.gxz;
-            diff.gyy += a.gyy - b.gyy;
-            diff.gyz += a.gyz - b.gyz;
-            diff.gzz += a.gzz - b.gzz;
+            add_change(a, b, diff);
           }
         }
+    // its own image at any height: the image force -q^2 / (4 h^2) of a particle falling onto
+    // the electrode changes fastest of all its far terms
+    if (geo_.electrode) {
+      const double z0 = geo_.electrode_z;
+      const Vec3 ip = p ? image_dipole({p[3 * i], p[3 * i + 1], p[3 * i + 2]}) : Vec3{};
+      const double ipv[3] = {ip.x, ip.y, ip.z};
+      const double dn[3] = {0.0, 0.0, 2.0 * (ri[2] - z0)}, dt[3] = {0.0, 0.0, 2.0 * (ri_then[2] - z0)};
+      const FieldTerms<double> a = source_terms(image_charge(q[i]), p ? ipv : nullptr, dn, gradient);
+      const FieldTerms<double> b = source_terms(image_charge(q[i]), p ? ipv : nullptr, dt, gradient);
+      ++pairs_;
+      add_change(a, b, diff);
+    }
     PointField change;
     add_terms(diff, change);
     const Vec3 &de = change.e;

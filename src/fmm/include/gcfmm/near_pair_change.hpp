@@ -4,8 +4,9 @@
 // pairs since then, with the charges and dipoles held at the evaluation's values:
 //   F_i(t) = F_i(t_e) + sum_{k near i} [f_ik(t) - f_ik(t_e)],   f_ik = q_i E_k(r_i) + G_k(r_i) p_i
 // over the other particles and their periodic copies, and (with a grounded electrode) every
-// particle's mirror image, itself included; a pair is near when it is closer than the cutoff
-// now or at the evaluation (so a pair entering or leaving the cutoff adds no jump). The far part
+// particle's mirror image; a pair is near when it is closer than the cutoff now or at the
+// evaluation (so a pair entering or leaving the cutoff adds no jump), and a particle's own image
+// is always near (its pull changes fastest as the particle falls onto the electrode). The far part
 // (everything else) is held. The pair terms are those of dipole_kernels.hpp (one home).
 #ifndef GCFMM_NEAR_PAIR_CHANGE_HPP
 #define GCFMM_NEAR_PAIR_CHANGE_HPP
