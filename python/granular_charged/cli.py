@@ -155,6 +155,19 @@ def build_parser() -> argparse.ArgumentParser:
                    help="run nothing: the tables, claims and figures of the runs finished in "
                         "--out so far (a study that grows over several sittings)")
 
+    p = sub.add_parser("epd", parents=[common],
+                       help="the electrophoretic deposition study (doc/epd.md), resumable",
+                       description="Charged particles (2 um, 1 m/s, 10 mJ/m^2, 400 e0) driven by "
+                                   "an applied field onto a grounded floor electrode, E0 = 1e5 and "
+                                   "3e5 V/m, eps_p = 0 (not polarisable) and 3.8, N = 500 in "
+                                   "L = 14 r_p, three seeds: phi, <Z>, f(Z) and the contact "
+                                   "directions against the field, mean +- sd over the seeds "
+                                   "(printed and in OUT/epd.csv). Resumable; --finished-only "
+                                   "tabulates what is finished.")
+    _study_options(p, "epd", "deck variables for every run")
+    p.add_argument("--finished-only", action="store_true",
+                   help="run nothing: the table of the runs finished in --out so far")
+
     p = sub.add_parser("demo", parents=[common],
                        help="the reduced Fig. 2 study: runs, table, Table 2, figures",
                        description=DEMO_DESCRIPTION,
@@ -344,8 +357,32 @@ def cmd_demo(a) -> int:
     return 0 if res["complete"] else 1
 
 
+def cmd_epd(a) -> int:
+    from . import epd
+    from .runner import Runner
+    from .sweep import Sweep, load_results
+    _, extra = _vars(a, "epd")
+    params = epd.study_params(tuple(a.seeds))
+    for p in params:
+        p.extra.update(extra)
+        Runner.check(p, 0)
+    out = _out_dir(a.out)
+    runs = out / "runs"
+    if not a.finished_only:
+        Sweep(_runner(a, not a.no_render), runs, jobs=a.jobs, progress=a.progress).run(params)
+    keys = {p.key() for p in params}
+    results = [r for r in load_results(runs) if r["key"] in keys] if runs.exists() else []
+    if not results:
+        log.error("no finished runs of the study in %s", runs)
+        return 1
+    t = epd.table(results)
+    t.to_csv(out / "epd.csv", index=False)
+    print(epd.format_table(t))
+    return 0 if a.finished_only or len(results) == len(params) else 1
+
+
 COMMANDS = {"run": cmd_run, "sweep": cmd_sweep, "figures": cmd_figures, "table2": cmd_table2,
-            "reproduce": cmd_reproduce, "demo": cmd_demo}
+            "reproduce": cmd_reproduce, "demo": cmd_demo, "epd": cmd_epd}
 
 
 def main(argv=None) -> int:

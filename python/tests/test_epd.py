@@ -1,0 +1,56 @@
+"""The EPD study's table (granular_charged.epd) on runs with known contacts, and its run list."""
+import json
+
+import numpy as np
+import pytest
+
+from granular_charged import epd
+
+
+def _layers(path, nlayers):
+    # nlayers square layers (4 x 4, spacing 2, radius 1) stacked along z in a box of 8 x 8
+    xs = np.arange(4) * 2.0 + 1.0
+    x, y = np.meshgrid(xs, xs)
+    rows = []
+    for layer in range(nlayers):
+        for a, b in zip(x.ravel(), y.ravel()):
+            rows.append((len(rows) + 1, a, b, 1.0 + 2.0 * layer))
+    text = ["ITEM: TIMESTEP", "0", "ITEM: NUMBER OF ATOMS", str(len(rows)),
+            "ITEM: BOX BOUNDS pp pp ff", "0 8", "0 8", "0 20", "ITEM: ATOMS id type x y z radius"]
+    text += [f"{i} 1 {a} {b} {z} 1.0" for i, a, b, z in rows]
+    path.write_text("\n".join(text) + "\n")
+
+
+def _result(tmp_path, name, E0, eps, seed, phi, nlayers):
+    d = tmp_path / name
+    d.mkdir()
+    _layers(d / "final.dump", nlayers)
+    return {"key": name, "dir": str(d), "phi": phi, "Z": 4.0 + seed, "fZ": [0, 0.5, 0, 0, 0.5],
+            "zlo": 0.0, "zhi": 100.0,
+            "params": {"seed": seed, "extra": {"E0": E0, "eps_p": eps, "electrode": "yes"}}}
+
+
+def test_table_means_and_orientation(tmp_path):
+    # two seeds of one case: one layer (S = -1/2) and two layers (S = -0.2, measures' test):
+    # the mean -0.35 with the sd of the two; phi and <Z> means and sds over the seeds
+    rs = [_result(tmp_path, "a", "1e5", "3.8", 1, 0.30, 1), _result(tmp_path, "b", "1e5", "3.8", 2, 0.34, 2),
+          _result(tmp_path, "c", "3e5", "0", 1, 0.25, 2)]
+    t = epd.table(rs)
+    assert list(t["E0"]) == [1e5, 3e5] and list(t["eps_p"]) == [3.8, 0.0]
+    r = t.iloc[0]
+    assert r["runs"] == 2
+    assert r["phi"] == pytest.approx(0.32) and r["phi_sd"] == pytest.approx(np.std([0.30, 0.34], ddof=1))
+    assert r["Z"] == pytest.approx(5.5)
+    assert r["S"] == pytest.approx(-0.35) and r["S_sd"] == pytest.approx(np.std([-0.5, -0.2], ddof=1))
+    assert r["fZ_1_2"] == pytest.approx(0.5) and r["fZ_4_6"] == pytest.approx(0.5)
+    assert t.iloc[1]["S"] == pytest.approx(-0.2)
+    assert "+-" in epd.format_table(t)
+
+
+def test_study_runs_every_case_and_seed():
+    ps = epd.study_params((1, 2, 3))
+    assert len(ps) == len(epd.FIELDS) * len(epd.PERMITTIVITIES) * 3
+    assert len({p.key() for p in ps}) == len(ps)
+    assert all(p.extra["electrode"] == "yes" and p.N == 500 and p.q == 400 for p in ps)
+    # the same folders as `granular-charged run --var L_rp 14 --var E0 1e5 --var eps_p 3.8 ...`
+    assert any(p.key().endswith("_E01e5_L_rp14_electrodeyes_eps_p3.8") for p in ps)
