@@ -74,7 +74,8 @@ class FixCoulFMM : public Fix {
   std::unique_ptr<CoulFMMEvaluator> evaluator;    // atoms -> solver -> field
   std::unique_ptr<CoulFMMComm> mpi;
   std::unique_ptr<class CoulFMMNearRefresh> near;    // the near refresh's list and buffers
-  // keywords efield, polarize, electrode: every step by gcfmm::PolarizableSolver (null if none)
+  // keywords efield, polarize, electrode: gcfmm::PolarizableSolver on the schedule's steps, continued
+  // in between (null if none)
   std::unique_ptr<CoulFMMPolarizable> polarizable;
   int field_cols;                  // per-atom columns: 4, or 7 with the dipole
   double **polar_force;            // per atom: q E + (p . grad) E of the last evaluation
