@@ -67,7 +67,8 @@ void CoulFMMPolarizable::init(const gcfmm::Options &opts)
                "average far field smears charges only)");
   gcfmm::PolarizationSettings induction;
   induction.tolerance = s.tolerance > 0.0 ? s.tolerance : 0.1 * opts.accuracy;
-  solver = std::make_unique<gcfmm::PolarizableSolver>(opts);
+  induction_tolerance = induction.tolerance;
+  solver = std::make_unique<gcfmm::PolarizableSolver>(opts, s.polarize);
   solver->set_induction(induction);
   // every rank computes its share of the targets of each evaluation, one sum completes them
   // (each value comes from one rank: the same result as on one rank)
@@ -276,7 +277,7 @@ double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool pre
     error->all(FLERR,
                "Fix coul/fmm polarize: the induced dipoles did not converge (residual {:.3g} > "
                "{:.3g} after {} iterations): the particles overlap too much for point dipoles",
-               rep.residual, s.tolerance > 0.0 ? s.tolerance : 0.1 * solver->options().accuracy,
+               rep.residual, induction_tolerance,
                rep.iterations);
   prev_tag.swap(last_tag);
   prev_p.swap(last_p);

@@ -113,6 +113,7 @@ class CoulFMMPolarizable : protected Pointers {
     bigint step = -1;
   } eval;
   double near_cutoff = 0.0;
+  double induction_tolerance = 0.0;
   bool measure = false, extrapolate = false;
   std::vector<size_t> all_k;      // 0 .. n - 1: every gathered atom as a target
   double last_prediction_error = -1.0;

@@ -12,9 +12,16 @@
 
 namespace gcfmm {
 
-PolarizableSolver::PolarizableSolver(const Options &opts) : solver_(opts) {
+namespace {
+Options expansion_options(Options opts, bool dipoles) {
+  if (dipoles && opts.order <= 0) opts.accuracy /= PolarizableSolver::dipole_accuracy_margin(opts.accuracy);
+  return opts;
+}
+}  // namespace
+
+PolarizableSolver::PolarizableSolver(const Options &opts, bool dipoles) : solver_(expansion_options(opts, dipoles)) {
   PolarizationSettings s;
-  s.tolerance = 0.1 * solver_.options().accuracy;
+  s.tolerance = 0.1 * opts.accuracy;
   set_induction(s);
 }
 
