@@ -57,13 +57,7 @@ Solution fmm(const gcfmm_bench::Bed &b, const std::vector<double> *alpha, const 
 }
 
 Solution direct(const gcfmm_bench::Bed &b, const std::vector<double> &alpha, const PolarizableEnvironment &env) {
-  PolarizableSystem sys;
-  sys.n = b.size();
-  sys.x = b.x.data();
-  sys.y = b.y.data();
-  sys.z = b.z.data();
-  sys.q = b.q.data();
-  sys.alpha = alpha.data();
+  PolarizableSystem sys = particles_of(b.size(), b.x.data(), b.y.data(), b.z.data(), b.q.data(), alpha.data());
   sys.applied_field = env.applied_field;
   sys.electrode = env.electrode;
   sys.electrode_z = env.electrode_z;

@@ -45,20 +45,6 @@ template <class Add> void check_derivatives(Add add, const Vec3 &d)
   EXPECT_NEAR(f.g.xx + f.g.yy + f.g.zz, 0.0, 1e-12);   // div E = 0 away from the source
 }
 
-// A system of n particles at (x, y, z) with charges q (and polarizabilities alpha, or none).
-PolarizableSystem particles(std::size_t n, const double *x, const double *y, const double *z,
-                            const double *q, const double *alpha = nullptr)
-{
-  PolarizableSystem s;
-  s.n = n;
-  s.x = x;
-  s.y = y;
-  s.z = z;
-  s.q = q;
-  s.alpha = alpha;
-  return s;
-}
-
 }  // namespace
 
 TEST(DipoleKernels, FieldIsMinusGradientOfPotentialAndGradientOfField)
@@ -91,7 +77,7 @@ TEST(DirectPolarizable, ChargeAboveGroundedPlane)
   // image force q^2 / (4 h^2) towards the plane (SI: q^2 / (16 pi eps0 h^2)), energy -q^2/(4h)
   const double q = 2.0, h = 0.7, z0 = -0.3;
   const double x = 0.1, y = 0.2, z = z0 + h;
-  PolarizableSystem s = particles(1, &x, &y, &z, &q);
+  PolarizableSystem s = particles_of(1, &x, &y, &z, &q);
     s.electrode = true;
   s.electrode_z = z0;
   const auto r = solve_polarizable_direct(s, {});
@@ -111,7 +97,7 @@ TEST(DirectPolarizable, TwoSpheresInAUniformField)
     for (int along = 0; along < 2; ++along) {
       const double x[2] = {0.0, along ? 0.0 : dist}, y[2] = {0.0, 0.0},
                    z[2] = {0.0, along ? dist : 0.0}, q[2] = {0.0, 0.0}, a[2] = {alpha, alpha};
-      PolarizableSystem s = particles(2, x, y, z, q, a);
+      PolarizableSystem s = particles_of(2, x, y, z, q, a);
             s.applied_field = {0.0, 0.0, 1.5};
       PolarizationSettings set;
       set.tolerance = 1e-13;
@@ -136,7 +122,7 @@ TEST(DirectPolarizable, InducedDipoleAboveGroundedPlane)
   // a sphere at height h in the normal field E: its image dipole (0, 0, p) at distance 2 h adds
   // 2 p / (2h)^3 at it, so p = alpha E / (1 - alpha / (4 h^3)); the pull is -6 p^2 / (2h)^4
   const double alpha = 0.9, h = 1.1, E = 2.0, x = 0, y = 0, z = h, q = 0;
-  PolarizableSystem s = particles(1, &x, &y, &z, &q, &alpha);
+  PolarizableSystem s = particles_of(1, &x, &y, &z, &q, &alpha);
     s.applied_field = {0.0, 0.0, E};
   s.electrode = true;
   PolarizationSettings set;
@@ -162,7 +148,7 @@ PolarizableResult random_system(const std::vector<double> &pos, const std::vecto
     y[i] = pos[3 * i + 1];
     z[i] = pos[3 * i + 2];
   }
-  PolarizableSystem s = particles(n, x.data(), y.data(), z.data(), q.data(), alpha.data());
+  PolarizableSystem s = particles_of(n, x.data(), y.data(), z.data(), q.data(), alpha.data());
     s.applied_field = {0.0, 0.0, 0.7};
   s.electrode = true;
   s.electrode_z = -0.5;
@@ -273,7 +259,7 @@ TEST(InducedDipoles, BadInputIsRefused)
   };
   EXPECT_THROW(solve_induced_dipoles(2, alpha, e0, none, p, {}), std::invalid_argument);
   const double x = 0, y = 0, z = -1, q = 1;
-  PolarizableSystem s = particles(1, &x, &y, &z, &q);
+  PolarizableSystem s = particles_of(1, &x, &y, &z, &q);
     s.electrode = true;
   EXPECT_THROW(solve_polarizable_direct(s, {}), std::invalid_argument);
 }

@@ -107,14 +107,7 @@ Errors errors(const Result &a, const Result &ref)
 // the direct reference's view of the particles s with polarizabilities alpha
 PolarizableSystem system_of(const Sources &s, const std::vector<double> &alpha)
 {
-  PolarizableSystem sys;
-  sys.n = s.size();
-  sys.x = s.x.data();
-  sys.y = s.y.data();
-  sys.z = s.z.data();
-  sys.q = s.q.data();
-  sys.alpha = alpha.data();
-  return sys;
+  return particles_of(s.size(), s.x.data(), s.y.data(), s.z.data(), s.q.data(), alpha.data());
 }
 
 Options high_accuracy(Boundary b = Boundary::Free, FarField ff = FarField::None)

@@ -28,6 +28,20 @@ struct PolarizableSystem {
   int images = 0;                  //!< copies (i lx, j ly) with max(|i|, |j|) <= images
 };
 
+//! A system of n particles at (x, y, z) with charges q and polarizabilities alpha (null: no
+//! dipoles), the surroundings at their defaults (no field, no electrode, no copies).
+inline PolarizableSystem particles_of(std::size_t n, const double *x, const double *y, const double *z,
+                                      const double *q, const double *alpha = nullptr) {
+  PolarizableSystem s;
+  s.n = n;
+  s.x = x;
+  s.y = y;
+  s.z = z;
+  s.q = q;
+  s.alpha = alpha;
+  return s;
+}
+
 //! The solution: per particle dipole, potential, field, field gradient, force; total energy.
 struct PolarizableResult {
   std::vector<Vec3> dipole;
