@@ -3,13 +3,15 @@ one sitting grows over several (doc/data/README.md).
 
     /usr/bin/python3 scripts/keep_runs.py STUDY_OUT/runs doc/data/paper-size/runs
     /usr/bin/python3 scripts/keep_runs.py --table2 STUDY_OUT/table2 doc/data/paper-size/table2
+    /usr/bin/python3 scripts/keep_runs.py --images EPD_OUT/runs doc/data/epd/runs
 
 Copies, for every run folder of SRC with a complete result.json that DST lacks: result.json,
 measures.json (computed here when missing), final.dump and forces.dump gzip-compressed (the
 package reads path.gz where path is absent), and for the run with a followed particle (the
 first seed of a case) its tracer.dump up to 100 samples after the first contact (the dump
 follows it every 10 steps to the end of the run) and the rendered packing.png at half size. Logs, restarts
-and other dumps stay behind (~120 KB per run, ~0.5 MB with a tracer). Existing run folders of
+and other dumps stay behind (~120 KB per run, ~0.5 MB with a tracer). With --images every run's
+packing.png is kept at half size (~150 KB; the EPD study's pictures). Existing run folders of
 DST are left as they are.
 """
 from __future__ import annotations
@@ -40,7 +42,7 @@ def half_size_png(src: Path, dst: Path):
         im.reduce(2).save(dst, optimize=True)
 
 
-def keep(src: Path, dst: Path) -> int:
+def keep(src: Path, dst: Path, images: bool = False) -> int:
     kept = 0
     for run in sorted(p for p in src.iterdir() if p.is_dir()):
         res = read_result(run / "result.json")
@@ -63,8 +65,8 @@ def keep(src: Path, dst: Path) -> int:
             # the approach up to its first contact, and 100 samples after it (measures, figures)
             with gzip.open(tmp / "tracer.dump.gz", "wt", 9) as fo:
                 fo.write(tracer_snapshots((run / "tracer.dump").read_text(), approach[2] + 101))
-            if (run / "packing.png").exists():
-                half_size_png(run / "packing.png", tmp / "packing.png")
+        if (approach is not None or images) and (run / "packing.png").exists():
+            half_size_png(run / "packing.png", tmp / "packing.png")
         tmp.rename(target)
         kept += 1
     return kept
@@ -101,11 +103,12 @@ def keep_table2(src: Path, dst: Path) -> int:
 if __name__ == "__main__":
     args = sys.argv[1:]
     table2 = args[:1] == ["--table2"]
-    if table2:
+    images = args[:1] == ["--images"]
+    if table2 or images:
         args = args[1:]
     if len(args) != 2:
         sys.exit(__doc__)
     src, dst = Path(args[0]), Path(args[1])
     dst.mkdir(parents=True, exist_ok=True)
-    n = keep_table2(src, dst) if table2 else keep(src, dst)
+    n = keep_table2(src, dst) if table2 else keep(src, dst, images)
     print(f"kept {n} new runs in {dst}")

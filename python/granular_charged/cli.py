@@ -378,6 +378,8 @@ def cmd_epd(a) -> int:
     t = epd.table(results)
     t.to_csv(out / "epd.csv", index=False)
     print(epd.format_table(t))
+    for path in epd.figures(results, out / "figures"):
+        print(f"figure: {path}")
     return 0 if a.finished_only or len(results) == len(params) else 1
 
 

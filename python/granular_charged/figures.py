@@ -57,7 +57,7 @@ def z_colormap():
     return ListedColormap(paper.Z_COLORS), BoundaryNorm(np.arange(-0.5, n), n)
 
 
-def _z_colorbar(fig, ax):
+def z_colorbar(fig, ax):
     cmap, norm = z_colormap()
     n = len(paper.Z_COLORS)
     cb = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, ticks=range(n), shrink=0.8,
@@ -106,8 +106,8 @@ def packing_image(result: dict, out: Path, name: str | None = None) -> Path:
     name = name or f"packing_q{p['q']:g}_s{p['seed']}.png"
     fig = new_figure(5.6, 5.0)
     ax = fig.add_subplot(111)
-    _packing_panel(fig, ax, result)
-    _z_colorbar(fig, ax)
+    packing_panel(fig, ax, result)
+    z_colorbar(fig, ax)
     return save(fig, Path(out) / name)
 
 
@@ -121,7 +121,7 @@ def _crop_white(img, pad=8):
     return img[max(r[0] - pad, 0): r[-1] + pad + 1, max(c[0] - pad, 0): c[-1] + pad + 1]
 
 
-def _packing_panel(fig, ax, result):
+def packing_panel(fig, ax, result):
     p = result["params"]
     img = Path(result["dir"]) / "packing.png"
     if img.exists():
@@ -155,9 +155,9 @@ def packings_panel(results: list[dict], out: Path) -> Path | None:
     fig = new_figure(3.4 * n + 1.0, 4.3)
     axes = [fig.add_subplot(1, n, k + 1) for k in range(n)]
     for ax, (_, row), lab in zip(axes, picks.iterrows(), "abcdefgh"):
-        _packing_panel(fig, ax, byk[row["key"]])
+        packing_panel(fig, ax, byk[row["key"]])
         ax.set_title(f"({lab}) " + ax.get_title(), fontsize=7)
-    _z_colorbar(fig, axes)
+    z_colorbar(fig, axes)
     fig.suptitle(f"{_label(key)}. Paper (Fig. 2, Table 2; N = 2000, L = 28 r_p): neutral "
                  f"phi = {paper.TABLE2[0][1]}, <Z> = {paper.TABLE2[0][2]}", fontsize=8)
     return save(fig, Path(out) / "packings.png", picks.drop(columns=["dir"]), tight=False)

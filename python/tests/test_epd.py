@@ -54,3 +54,27 @@ def test_study_runs_every_case_and_seed():
     assert all(p.extra["electrode"] == "yes" and p.N == 500 and p.q == 400 for p in ps)
     # the same folders as `granular-charged run --var L_rp 14 --var E0 1e5 --var eps_p 3.8 ...`
     assert any(p.key().endswith("_E01e5_L_rp14_electrodeyes_eps_p3.8") for p in ps)
+
+
+def test_figures_draw_every_case_and_the_orientation(tmp_path):
+    # two cases, one with two seeds: one packing panel per case (the side view from the dump:
+    # no render here), and the |cos theta| densities averaged over the seeds: one layer has
+    # only horizontal contacts (|cos| < 0.1), two layers a fifth vertical ones (|cos| > 0.9)
+    rs = [_result(tmp_path, "a", "1e5", "3.8", 1, 0.30, 1), _result(tmp_path, "b", "1e5", "3.8", 2, 0.34, 2),
+          _result(tmp_path, "c", "3e5", "0", 1, 0.25, 2)]
+    for r in rs:
+        r["params"]["q"] = 400.0
+        r["natoms"] = 16
+    paths = epd.figures(rs, tmp_path / "figures")
+    assert [p.name for p in paths] == ["packings.png", "orientation.png"]
+    assert all(p.stat().st_size > 10000 for p in paths)
+    import pandas as pd
+    panels = pd.read_csv(tmp_path / "figures" / "packings.csv")
+    assert list(zip(panels["E0"], panels["eps_p"], panels["seed"])) == [(1e5, 3.8, 1), (3e5, 0.0, 1)]
+    g = pd.read_csv(tmp_path / "figures" / "orientation.csv")
+    one = g[(g["E0"] == 1e5)].sort_values("abs_cos")
+    assert one["seeds"].iloc[0] == 2
+    # one layer (periodic 4 x 4): 32 of 32 contacts horizontal -> density 10 in the first of 10
+    # bins; two layers: 64 of 80 -> 8, and 16 vertical -> 2 in the last: means 9 and 1
+    assert one["density"].iloc[0] == pytest.approx((10.0 + 10.0 * 64 / 80) / 2)
+    assert one["density"].iloc[-1] == pytest.approx((0.0 + 10.0 * 16 / 80) / 2)
