@@ -10,6 +10,9 @@ r_p = 1 um; si units. Atoms at rest (no integrator): `run steps` re-evaluates th
 Usage: bench_coulomb.py [--sizes 2000 20000 200000] [--lmp build/lmp] [--np 1] [--repeat 3]
        bench_coulomb.py --ranks 1 2 [--sizes 200000]   (fix coul/fmm only: time per evaluation
                                                       on each number of MPI ranks, one run)
+       bench_coulomb.py --ranks 1 2 --keywords "polarize 3.8 efield 0 0 -1e5 electrode 0.0"
+                                                     (the same with more keywords of the fix;
+                                                      atoms with radii r_p)
 """
 import argparse
 import os
@@ -27,7 +30,7 @@ RP = 1.0e-6
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
-def write_data(path, n, seed=2016):
+def write_data(path, n, seed=2016, spheres=False):
     rng = np.random.default_rng(seed)
     lx = 28 * RP * np.sqrt(n / 2000.0)
     nbed = int(0.9 * n)
@@ -67,28 +70,32 @@ def write_data(path, n, seed=2016):
             k += 1
     with open(path, "w") as f:
         f.write(f"deposition-like charges\n\n{n} atoms\n1 atom types\n\n")
-        f.write(f"0 {lx:.17g} xlo xhi\n0 {lx:.17g} ylo yhi\n0 {162*RP:.17g} zlo zhi\n\nAtoms # charge\n\n")
+        style = "hybrid sphere charge" if spheres else "charge"
+        f.write(f"0 {lx:.17g} xlo xhi\n0 {lx:.17g} ylo yhi\n0 {162*RP:.17g} zlo zhi\n\nAtoms # {style}\n\n")
         for i, (x, y, z) in enumerate(pos, 1):
-            f.write(f"{i} 1 {400*E0:.17g} {x:.17g} {y:.17g} {z:.17g}\n")
+            if spheres:    # silica-like, diameter 2 r_p
+                f.write(f"{i} 1 {x:.17g} {y:.17g} {z:.17g} {2*RP:.17g} 2500 {400*E0:.17g}\n")
+            else:
+                f.write(f"{i} 1 {400*E0:.17g} {x:.17g} {y:.17g} {z:.17g}\n")
     return lx
 
 
-def run(lmp, np_, data, method, acc, cut, steps, out, repeat=1, solver="replicated"):
+def run(lmp, np_, data, method, acc, cut, steps, out, repeat=1, solver="replicated", extra=""):
     """time per evaluation (the best of `repeat` runs: this shared machine's single timings vary
     by up to 2x) and the forces (deterministic)"""
     times = []
     for _ in range(repeat):
-        t, f = run_once(lmp, np_, data, method, acc, cut, steps, out, solver)
+        t, f = run_once(lmp, np_, data, method, acc, cut, steps, out, solver, extra)
         times.append(t)
     return min(times), f
 
 
-def run_once(lmp, np_, data, method, acc, cut, steps, out, solver="replicated"):
+def run_once(lmp, np_, data, method, acc, cut, steps, out, solver="replicated", extra=""):
     cmd = ([] if np_ == 1 else ["mpirun", "-np", str(np_), "--oversubscribe"]) + [
         lmp, "-log", "none", "-echo", "none", "-in", os.path.join(HERE, "in.coulomb"),
         "-var", "data", data, "-var", "method", method, "-var", "acc", str(acc),
         "-var", "cut", str(cut), "-var", "steps", str(steps), "-var", "out", out,
-        "-var", "solver", solver]
+        "-var", "solver", solver, "-var", "spheres", "yes" if extra else "no", "-var", "extra", extra]
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     res = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if res.returncode != 0:
@@ -121,7 +128,12 @@ def main():
                     choices=["replicated", "distributed"],
                     help="fix coul/fmm's solver keyword(s): with --ranks each on every rank count, "
                          "otherwise the first one")
+    ap.add_argument("--keywords", default="",
+                    help="with --ranks: more keywords of fix coul/fmm, e.g. 'polarize 3.8 efield 0 0 "
+                         "-1e5 electrode 0.0' (the atoms then have radii r_p and density 2500)")
     args = ap.parse_args()
+    if args.keywords and not args.ranks:
+        ap.error("--keywords needs --ranks")
     tmp = tempfile.mkdtemp(prefix="gc-bench-")
     try:
         return ranks(args, tmp) if args.ranks else compare(args, tmp)
@@ -175,13 +187,14 @@ def ranks(args, tmp):
     print("|---|---|---|---|---|---|---|")
     for n in args.sizes:
         data = os.path.join(tmp, f"data.{n}")
-        write_data(data, n)
+        write_data(data, n, spheres=bool(args.keywords))
+        extra = args.keywords
         steps = 3 if n >= 2000000 else (5 if n >= 200000 else 20)
         base = None
         for solver in args.solver:
             for np_ in args.ranks:
                 t, f = run(args.lmp, np_, data, "fmm", acc, 2 * RP, steps,
-                           os.path.join(tmp, f"f.{n}.{np_}"), args.repeat, solver)
+                           os.path.join(tmp, f"f.{n}.{np_}"), args.repeat, solver, extra)
                 if base is None:
                     base = (t, f)
                 print(f"| {n} | {acc} | {solver} | {np_} | {1e3*t:.1f} | {base[0]/t:.2f} | "
