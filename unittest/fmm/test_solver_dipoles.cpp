@@ -555,6 +555,51 @@ TEST(SolverDipoles, TargetsSubset)
   }
 }
 
+// work partitions with FieldOutputs::targets: the parts split the targets' work, not the
+// sources' (an electrode's images are sources only and lie apart, below the plane): two parts
+// over 2000 targets above z = 0 and their 2000 mirror images each get about half the targets
+// (within 35-65%: the estimate weighs P2P and M2L work, not the count). Weighing every source
+// instead gives one part ~all the targets (seen: 2000 and 0), the other nothing to do.
+TEST(SolverDipoles, PartitionsSplitTheTargets)
+{
+  Sources s = random_sources(2000, 53, 1.0, 1.0);
+  for (auto *v : {&s.x, &s.y, &s.z, &s.q, &s.px, &s.py, &s.pz}) v->resize(4000);
+  for (std::size_t i = 0; i < 2000; ++i) {
+    s.z[i] += 0.05;
+    s.x[2000 + i] = s.x[i];
+    s.y[2000 + i] = s.y[i];
+    s.z[2000 + i] = -s.z[i];
+    s.q[2000 + i] = -s.q[i];
+    s.px[2000 + i] = -s.px[i];
+    s.py[2000 + i] = -s.py[i];
+    s.pz[2000 + i] = s.pz[i];
+  }
+  Solver solver(Options{});
+  solver.build(s.size(), s.x.data(), s.y.data(), s.z.data());
+  std::size_t total = 0;
+  for (int part = 0; part < 2; ++part) {
+    Result r(s.size());
+    FieldOutputs o = r.outputs();
+    o.targets = 2000;
+    solver.evaluate_dipoles(s.view(), o, part, 2);
+    std::size_t mine = 0;
+    for (std::size_t i = 0; i < 2000; ++i) mine += r.ez[i] != 0.0;
+    std::printf("[ partition ] part %d: %zu of 2000 targets\n", part, mine);
+    EXPECT_GT(mine, 700u) << "part " << part;
+    EXPECT_LT(mine, 1300u) << "part " << part;
+    total += mine;
+  }
+  EXPECT_EQ(total, 2000u);
+  // and back to all particles as targets: the split covers them all again
+  std::size_t all = 0;
+  for (int part = 0; part < 2; ++part) {
+    Result r(s.size());
+    solver.evaluate_dipoles(s.view(), r.outputs(), part, 2);
+    for (std::size_t i = 0; i < s.size(); ++i) all += r.ez[i] != 0.0;
+  }
+  EXPECT_EQ(all, s.size());
+}
+
 // set_partition: three parts run one after the other, their results summed as a communicator
 // would, give the one-part solution bit for bit (dipoles, forces, energy)
 TEST(PolarizableSolver, PartsSumToTheWhole)

@@ -136,11 +136,26 @@ void SolverCore::estimate_partition_costs() {
   for (const auto &e : lists.m2l) own[e.target] += m2l / nodes[e.target].count();
   for (std::size_t i = 0; i < nodes.size(); ++i)
     if (nodes[i].parent >= 0) own[i] += own[nodes[i].parent];
+  leaf_target_cost.resize(tree.leaves.size());
+  for (std::size_t l = 0; l < tree.leaves.size(); ++l) leaf_target_cost[l] = l2p_cost(p) + own[tree.leaves[l]];
+  weigh_leaves(n);
+}
+
+// the cost of a leaf is that of its targets: with sources that are not targets (an
+// electrode's images) the work partitions then split the targets' work, not the particles
+void SolverCore::weigh_leaves(std::size_t targets) {
+  const auto &nodes = tree.nodes;
   leaf_prefix.assign(tree.leaves.size() + 1, 0.0);
   for (std::size_t l = 0; l < tree.leaves.size(); ++l) {
-    const std::int32_t leaf = tree.leaves[l];
-    leaf_prefix[l + 1] = leaf_prefix[l] + nodes[leaf].count() * (l2p_cost(p) + own[leaf]);
+    const Node &leaf = nodes[tree.leaves[l]];
+    std::size_t count = leaf.count();
+    if (targets < n) {
+      count = 0;
+      for (std::uint32_t k = leaf.begin; k < leaf.end; ++k) count += tree.perm[k] < targets;
+    }
+    leaf_prefix[l + 1] = leaf_prefix[l] + double(count) * leaf_target_cost[l];
   }
+  weighed_targets = std::min(targets, n);
 }
 
 // Pairs closer than r = kCoincidenceRadius (units of h, solver.hpp), periodic images

@@ -26,6 +26,7 @@ bool SolverCore::sort_dipoles(const DipoleSources &src) {
 
 void SolverCore::mark_targets(std::size_t targets) {
   node_has_target.clear();
+  if (std::min(targets, n) != weighed_targets) weigh_leaves(targets);
   if (targets >= n) return;
   const auto &nodes = tree.nodes;
   node_has_target.assign(nodes.size(), 0);

@@ -8,6 +8,7 @@ using namespace detail;
 
 void SolverCore::sort_charges(const double *q) {
   node_has_target.clear();  // evaluate(): every particle is a target
+  if (weighed_targets != n) weigh_leaves(n);
   const auto &perm = tree.perm;
   for (std::size_t k = 0; k < n; ++k) sorted_q[k] = q[perm[k]];
 }

@@ -243,6 +243,8 @@ struct SolverCore {
   std::vector<const double *> batch_m;        // M2L batch of one target node: source multipoles
   std::vector<Vec3> batch_r;                  // and translation vectors
   std::vector<double> leaf_prefix;            // cumulative estimated cost over leaves
+  std::vector<double> leaf_target_cost;       // estimated cost per target of each leaf
+  std::size_t weighed_targets = 0;            // leaf_prefix counts the particles below this index
   std::vector<std::pair<std::uint32_t, std::uint32_t>> coincident;  // sorted indices, closer than kCoincidenceRadius h
   double zmin = 0.0, zmax = 0.0;              // z range of all particles (units of h)
   double zhint_lo = NAN, zhint_hi = NAN;      // set_z_range(): range the far field covers
@@ -254,7 +256,7 @@ struct SolverCore {
   std::size_t memory_bytes() const {
     std::size_t b = tree_bytes(tree) + lists_bytes(lists) + far.memory_bytes();
     for (const auto *v : {&scaled_x, &scaled_y, &scaled_z, &multipole, &local, &sorted_q, &sorted_pot, &sorted_ex,
-                          &sorted_ey, &sorted_ez, &sorted_average_pot, &leaf_prefix, &sorted_px, &sorted_py,
+                          &sorted_ey, &sorted_ez, &sorted_average_pot, &leaf_prefix, &leaf_target_cost, &sorted_px, &sorted_py,
                           &sorted_pz, &sorted_g})
       b += vector_bytes(*v);
     b += vector_bytes(has_local) + vector_bytes(batch_m) + vector_bytes(batch_r) + vector_bytes(coincident);
@@ -296,6 +298,8 @@ struct SolverCore {
   void build_interaction_lists();
   void allocate_storage();
   void estimate_partition_costs();
+  // leaf_prefix from the targets among each leaf's particles (input index < targets)
+  void weigh_leaves(std::size_t targets);
   void find_coincident_pairs();
   void setup_far_field();
   // ---- evaluate phases ----
