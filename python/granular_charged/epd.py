@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from . import measures, packing
+from . import measures, packing, tables
 from .params import DepositionParams
 
 log = logging.getLogger(__name__)
@@ -39,6 +39,7 @@ def run_measures(result: dict) -> dict:
     out = {"E0": float(result["params"]["extra"].get("E0", 0.0)),
            "eps_p": float(result["params"]["extra"].get("eps_p", 0.0)),
            "seed": result["params"]["seed"], "phi": result.get("phi"), "Z": result.get("Z"),
+           "cpu_s": result.get("cpu_s", float("nan")),
            **measures.fz_populations(result.get("fZ") or [])}
     zlo, zhi = result.get("zlo"), result.get("zhi")
     if zlo is None or zhi is None or not zhi > zlo:
@@ -53,9 +54,9 @@ def run_measures(result: dict) -> dict:
 def table(results: list[dict]) -> pd.DataFrame:
     """Mean and standard deviation over the seeds of every measure, per (E_0, eps_p)."""
     df = pd.DataFrame([run_measures(r) for r in results])
-    for c in ("phi", "Z"):
+    for c in ("phi", "Z", "cpu_s"):
         df[c] = pd.to_numeric(df[c], errors="coerce")
-    keys = ["phi", "Z", "fZ_1_2", "fZ_4_6", "S", "mean_abs_cos"]
+    keys = ["phi", "Z", "fZ_1_2", "fZ_4_6", "S", "mean_abs_cos", "cpu_s"]
     agg = {"runs": ("seed", "count")}
     for k in keys:
         agg[k] = (k, "mean")
@@ -64,13 +65,17 @@ def table(results: list[dict]) -> pd.DataFrame:
 
 
 def format_table(t: pd.DataFrame) -> str:
-    lines = ["E0 [V/m]  eps_p  runs  phi              <Z>            f(Z=1-2)       f(Z=4-6)       S (contacts vs field)"]
+    """The table as printed: each measure as mean +- sd with the digits the seeds' scatter allows
+    (tables.with_uncertainty; one seed: 3 significant digits, no sd), CPU seconds per run."""
+    cols = [("phi", "phi"), ("Z", "<Z>"), ("fZ_1_2", "f(Z=1-2)"), ("fZ_4_6", "f(Z=4-6)"),
+            ("S", "S (contacts vs field)")]
+    rows = [["E0 [V/m]", "eps_p", "runs"] + [h for _, h in cols] + ["CPU s/run"]]
     for _, r in t.iterrows():
-        def pm(k, d=4):
-            return f"{r[k]:.{d}f} +- {r[k + '_sd']:.{d}f}" if np.isfinite(r[k]) else "nan"
-        lines.append(f"{r['E0']:8.0e}  {r['eps_p']:5.1f}  {int(r['runs']):4d}  {pm('phi')}  {pm('Z', 3)}  "
-                     f"{pm('fZ_1_2', 3)}  {pm('fZ_4_6', 3)}  {pm('S', 3)}")
-    return "\n".join(lines)
+        rows.append([f"{r['E0']:.0e}", f"{r['eps_p']:g}", f"{int(r['runs'])}"]
+                    + [tables.with_uncertainty(r[k], r[k + "_sd"]) for k, _ in cols]
+                    + [f"{r['cpu_s']:.0f}" if np.isfinite(r["cpu_s"]) else "-"])
+    widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]))]
+    return "\n".join("  ".join(c.rjust(w) for c, w in zip(row, widths)) for row in rows)
 
 
 def figures(results: list[dict], out: Path) -> list[Path]:

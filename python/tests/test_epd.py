@@ -26,7 +26,7 @@ def _result(tmp_path, name, E0, eps, seed, phi, nlayers):
     d.mkdir()
     _layers(d / "final.dump", nlayers)
     return {"key": name, "dir": str(d), "phi": phi, "Z": 4.0 + seed, "fZ": [0, 0.5, 0, 0, 0.5],
-            "zlo": 0.0, "zhi": 100.0,
+            "zlo": 0.0, "zhi": 100.0, "cpu_s": 100.0 * seed,
             "params": {"seed": seed, "extra": {"E0": E0, "eps_p": eps, "electrode": "yes"}}}
 
 
@@ -44,7 +44,11 @@ def test_table_means_and_orientation(tmp_path):
     assert r["S"] == pytest.approx(-0.35) and r["S_sd"] == pytest.approx(np.std([-0.5, -0.2], ddof=1))
     assert r["fZ_1_2"] == pytest.approx(0.5) and r["fZ_4_6"] == pytest.approx(0.5)
     assert t.iloc[1]["S"] == pytest.approx(-0.2)
-    assert "+-" in epd.format_table(t)
+    assert r["cpu_s"] == pytest.approx(150.0)
+    # printed with the digits the two seeds allow (two significant digits of the sd), one seed without sd
+    text = epd.format_table(t)
+    assert "0.320 +- 0.028" in text and "5.50 +- 0.71" in text and " 150" in text
+    assert text.splitlines()[2].split()[3] == "0.25"
 
 
 def test_study_runs_every_case_and_seed():
