@@ -15,15 +15,14 @@ from pathlib import Path
 import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "python"))
-from granular_charged import measures, packing, tables  # noqa: E402
+from granular_charged import epd, tables  # noqa: E402
 
 
 def main(dirs: list[str]) -> int:
     rows = []
     for d in map(Path, dirs):
-        r = json.loads((d / "result.json").read_text())
-        snap = packing.read_dump(d / "final.dump", last_only=True)   # reads final.dump.gz if kept so
-        o = measures.contact_orientation(snap, r["zlo"], r["zhi"])
+        r = {**json.loads((d / "result.json").read_text()), "dir": str(d)}
+        o = epd.contact_orientation_of_run(r)
         rows.append({"case": re.sub(r"_s\d+", "_s*", r["key"]), "seed": r["params"]["seed"],
                      "phi": r["phi"], "S": o["S"], "mean_abs_cos": o["mean_abs_cos"],
                      "contacts": o["contacts"]})

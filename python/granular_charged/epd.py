@@ -41,14 +41,19 @@ def run_measures(result: dict) -> dict:
            "seed": result["params"]["seed"], "phi": result.get("phi"), "Z": result.get("Z"),
            "cpu_s": result.get("cpu_s", float("nan")),
            **measures.fz_populations(result.get("fZ") or [])}
+    out.update(contact_orientation_of_run(result))
+    return out
+
+
+def contact_orientation_of_run(result: dict) -> dict:
+    """S, <|cos theta|> and the number of contacts in the analysis slab of one finished run (its
+    final.dump, or final.dump.gz as kept; NaN without a slab)."""
     zlo, zhi = result.get("zlo"), result.get("zhi")
     if zlo is None or zhi is None or not zhi > zlo:
-        out.update(S=float("nan"), mean_abs_cos=float("nan"), contacts=0)
-        return out
+        return {"S": float("nan"), "mean_abs_cos": float("nan"), "contacts": 0}
     snap = packing.read_dump(Path(result["dir"]) / "final.dump", last_only=True)
     o = measures.contact_orientation(snap, zlo, zhi)
-    out.update(S=o["S"], mean_abs_cos=o["mean_abs_cos"], contacts=o["contacts"])
-    return out
+    return {"S": o["S"], "mean_abs_cos": o["mean_abs_cos"], "contacts": o["contacts"]}
 
 
 def table(results: list[dict]) -> pd.DataFrame:
@@ -67,15 +72,14 @@ def table(results: list[dict]) -> pd.DataFrame:
 def format_table(t: pd.DataFrame) -> str:
     """The table as printed: each measure as mean +- sd with the digits the seeds' scatter allows
     (tables.with_uncertainty; one seed: 3 significant digits, no sd), CPU seconds per run."""
-    cols = [("phi", "phi"), ("Z", "<Z>"), ("fZ_1_2", "f(Z=1-2)"), ("fZ_4_6", "f(Z=4-6)"),
-            ("S", "S (contacts vs field)")]
-    rows = [["E0 [V/m]", "eps_p", "runs"] + [h for _, h in cols] + ["CPU s/run"]]
-    for _, r in t.iterrows():
-        rows.append([f"{r['E0']:.0e}", f"{r['eps_p']:g}", f"{int(r['runs'])}"]
-                    + [tables.with_uncertainty(r[k], r[k + "_sd"]) for k, _ in cols]
-                    + [f"{r['cpu_s']:.0f}" if np.isfinite(r["cpu_s"]) else "-"])
-    widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]))]
-    return "\n".join("  ".join(c.rjust(w) for c, w in zip(row, widths)) for row in rows)
+    cols = {"phi": "phi", "Z": "<Z>", "fZ_1_2": "f(Z=1-2)", "fZ_4_6": "f(Z=4-6)",
+            "S": "S (contacts vs field)"}
+    shown = pd.DataFrame({"E0 [V/m]": [f"{v:.0e}" for v in t["E0"]],
+                          "eps_p": [f"{v:g}" for v in t["eps_p"]], "runs": t["runs"].astype(int)})
+    for k, head in cols.items():
+        shown[head] = [tables.with_uncertainty(v, sd) for v, sd in zip(t[k], t[k + "_sd"])]
+    shown["CPU s/run"] = [f"{v:.0f}" if np.isfinite(v) else "-" for v in t["cpu_s"]]
+    return tables.format_table(shown)
 
 
 def figures(results: list[dict], out: Path) -> list[Path]:
