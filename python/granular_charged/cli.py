@@ -168,6 +168,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--finished-only", action="store_true",
                    help="run nothing: the table of the runs finished in --out so far")
 
+    p = sub.add_parser("conventions", parents=[common],
+                       help="the phi_0 question at paper size: the paper's open conventions "
+                            "(doc/reproduction.md), resumable",
+                       description="Which convention the paper leaves open gives its Table 2, "
+                                   "its neutral phi_0 range and its charge effect together: the "
+                                   "rolling limit theta_crit 0.01 (the deck's), 0.02, 0.04 at the "
+                                   "three neutral series of Fig. 3 and at 400 e0 (2 um, 1 m/s), "
+                                   "N = 2000 in L = 28 r_p, three seeds; phi in the slab or over "
+                                   "the whole bed (H_p = mean surface height or highest top), <Z> "
+                                   "in the slab or over all particles. Prints the per-case means "
+                                   "(OUT/conventions.csv) and the checks per convention "
+                                   "(OUT/conventions_checks.csv). The theta_crit 0.01 runs are "
+                                   "those of `reproduce --size paper` (the same folders under "
+                                   "OUT/runs). Resumable; --finished-only tabulates what is "
+                                   "finished.")
+    _study_options(p, "conventions", "deck variables for every run")
+    p.add_argument("--finished-only", action="store_true",
+                   help="run nothing: the tables of the runs finished in --out so far")
+
     p = sub.add_parser("demo", parents=[common],
                        help="the reduced Fig. 2 study: runs, table, Table 2, figures",
                        description=DEMO_DESCRIPTION,
@@ -209,6 +228,12 @@ def _refused(command: str) -> dict:
         # the study's cases set these; N by its size
         own.update({k: "reproduce sets it per case" for k in ("rp", "U0", "gamma", "q")},
                    N="reproduce sets it (--size)", L_rp="reproduce sets it (--size)")
+    if command == "conventions":
+        own.update({k: "the conventions study sets it per case" for k in
+                    ("rp", "U0", "gamma", "q", "theta_crit")},
+                   N="the conventions study runs the paper's N = 2000",
+                   L_rp="the conventions study runs the paper's L = 28 r_p",
+                   tracer="the conventions study follows none")
     if command in ("demo", "reproduce"):
         own["tracer"] = "use --tracer" if command == "demo" else "reproduce follows none"
     return dict(RESERVED, **own)
@@ -383,8 +408,41 @@ def cmd_epd(a) -> int:
     return 0 if a.finished_only or len(results) == len(params) else 1
 
 
+def cmd_conventions(a) -> int:
+    from . import conventions
+    from .runner import Runner
+    from .sweep import Sweep, load_results
+    fields, extra = _vars(a, "conventions")
+    params = conventions.study_params(tuple(a.seeds), extra=extra, fields=fields)
+    for p in params:
+        Runner.check(p, 0)
+    out = _out_dir(a.out)
+    runs = out / "runs"
+    if not a.finished_only:
+        Sweep(_runner(a, not a.no_render), runs, jobs=a.jobs, progress=a.progress).run(params)
+    keys = {p.key() for p in params}
+    results = [r for r in load_results(runs) if r["key"] in keys] if runs.exists() else []
+    if not results:
+        log.error("no finished runs of the study in %s", runs)
+        return 1
+    t = conventions.case_table(conventions.run_frame(results))
+    c = conventions.checks(t)
+    t.to_csv(out / "conventions.csv", index=False)
+    c.to_csv(out / "conventions_checks.csv", index=False)
+    text = "\n\n".join([f"{len(results)} of {len(params)} runs finished",
+                         conventions.format_cases(t), conventions.format_checks(c),
+                         conventions.verdict(c)])
+    (out / "conventions.txt").write_text(text + "\n")
+    print(text)
+    path = conventions.figure(t, out / "figures")
+    if path:
+        print(f"figure: {path}")
+    return 0 if a.finished_only or len(results) == len(params) else 1
+
+
 COMMANDS = {"run": cmd_run, "sweep": cmd_sweep, "figures": cmd_figures, "table2": cmd_table2,
-            "reproduce": cmd_reproduce, "demo": cmd_demo, "epd": cmd_epd}
+            "reproduce": cmd_reproduce, "demo": cmd_demo, "epd": cmd_epd,
+            "conventions": cmd_conventions}
 
 
 def main(argv=None) -> int:

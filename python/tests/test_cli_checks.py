@@ -56,9 +56,13 @@ def test_var_refuses_what_the_runner_sets(tmp_path):
     refused(gc(["sweep", "--out", "r", "--var", "seed", "3"], tmp_path), "use --seeds")
     refused(gc(["reproduce", "--var", "U0", "2"], tmp_path), "reproduce sets it per case")
     refused(gc(["demo", "--var", "q", "2"], tmp_path), "use --q")
+    # the conventions study sets the rolling limit per case and runs the paper's size
+    refused(gc(["conventions", "--var", "theta_crit", "0.04"], tmp_path),
+            "the conventions study sets it per case")
+    refused(gc(["conventions", "--var", "L_rp", "14"], tmp_path), "L = 28 r_p")
 
 
-@pytest.mark.parametrize("cmd", ["run", "sweep", "demo", "reproduce"])
+@pytest.mark.parametrize("cmd", ["run", "sweep", "demo", "reproduce", "conventions"])
 def test_var_unknown_to_the_deck_is_an_error(tmp_path, cmd):
     # before: a misspelled --var L_RP 10 was ignored by the deck but named the folder
     args = [cmd, "--var", "L_RP", "10"] + (["--out", "runs"] if cmd == "sweep" else [])
