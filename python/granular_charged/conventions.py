@@ -217,7 +217,8 @@ def verdict(c: pd.DataFrame) -> str:
 
 
 def figure(t: pd.DataFrame, out) -> "Path | None":
-    """conventions.png in OUT: per phi definition, the neutral phi_0 of the three series against
+    """phi0_question.png in OUT (beside reproduce's conventions.png, which compares the cases at the
+    deck's rolling limit): per phi definition, the neutral phi_0 of the three series against
     the rolling limit (mean +- sd over the seeds) with the paper's range as a band and its Table
     2 phi_0 as a star at every theta_crit; beside it <Z>_0 of the Table 2 case (slab and all
     particles) with the paper's 3.2056. The plotted means beside it as CSV."""
@@ -261,4 +262,4 @@ def figure(t: pd.DataFrame, out) -> "Path | None":
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     cols = KEYS + ["runs"] + [c for m in MEASURES for c in (m, f"{m}_sd")]
-    return fg.save(fig, out / "conventions.png", t[cols])
+    return fg.save(fig, out / "phi0_question.png", t[cols])
