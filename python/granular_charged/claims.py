@@ -162,26 +162,54 @@ def claim_lines(runs: pd.DataFrame) -> list[str]:
 def table2_lines(rows: list[dict]) -> list[str]:
     """The paper's Fig. 7 on its Table 2 packing: the normal-force pdf after the relaxation
     without and with charge (width, the share inside |F_n/F_C| < 0.1, the shift of the mean to
-    tension), one packing. The baseline is the q = 0 control after the same relaxation (the
-    relaxation alone moves the forces too); without the control, the packing before it."""
+    tension). The baseline is the q = 0 control of the same packing after the same relaxation
+    (the relaxation alone moves the forces too); without the control, the packing before it.
+    Several packings (one per seed): mean +- sd over them."""
     from pathlib import Path
+    stats = {}          # q -> [(baseline stats, charged stats)] over the packings
+    what = set()
+    for formed in dict.fromkeys(r.get("formed") for r in rows):
+        mine = [r for r in rows if r.get("formed") == formed]
+        control = [r for r in mine if r["q"] == 0]
+        for r in mine:
+            if r["q"] == 0:
+                continue
+            d = Path(r["dir"])
+            base = (Path(control[0]["dir"]) / "forces_after.dump" if control
+                    else d / "forces_before.dump")
+            if not (packing.dump_exists(base) and packing.dump_exists(d / "forces_after.dump")):
+                continue
+            what.add("q = 0 control" if control else "before charging")
+            stats.setdefault(r["q"], []).append(
+                (measures.force_stats(measures.normal_forces(base, r["params"])),
+                 measures.force_stats(measures.normal_forces(d / "forces_after.dump", r["params"]))))
     lines = []
-    control = [r for r in rows if r["q"] == 0]
-    for r in sorted(rows, key=lambda r: r["q"]):
-        if r["q"] == 0:
-            continue
-        d = Path(r["dir"])
-        base = (Path(control[0]["dir"]) / "forces_after.dump" if control
-                else d / "forces_before.dump")
-        if not (packing.dump_exists(base) and packing.dump_exists(d / "forces_after.dump")):
-            continue
-        b = measures.force_stats(measures.normal_forces(base, r["params"]))
-        a = measures.force_stats(measures.normal_forces(d / "forces_after.dump", r["params"]))
-        what = "q = 0 control" if control else "before charging"
+    for q in sorted(stats):
+        pairs = stats[q]
+        n = len(pairs)
+
+        def show(k, fmt, when):
+            v = np.array([p[when][k] for p in pairs])
+            if n == 1:
+                return fmt.format(v[0])
+            return with_uncertainty(v.mean(), v.std(ddof=1))
+
+        def change(k, fmt):
+            return f"{show(k, fmt, 0)} -> {show(k, fmt, 1)}"
+
+        def paired(k):
+            # the packings differ more from each other than charge changes one: the change
+            # packing by packing, mean +- sd
+            d = np.array([p[1][k] - p[0][k] for p in pairs])
+            return with_uncertainty(d.mean(), d.std(ddof=1))
+
+        packings = "one packing" if n == 1 else f"mean +- sd over {n} packings"
         lines.append(
-            f"Table 2 packing charged to {r['q']:g} e0 against the {what} (one packing): F_n/F_C sd "
-            f"{b['Fn_sd']:.3f} -> {a['Fn_sd']:.3f}, inside |F_n/F_C| < {paper.FORCE_RANGE:g} "
-            f"{b['Fn_inside']:.3f} -> {a['Fn_inside']:.3f} (paper: all), mean "
-            f"{b['Fn_mean']:+.5f} -> {a['Fn_mean']:+.5f}, tensile share {b['Fn_tensile']:.3f} -> "
-            f"{a['Fn_tensile']:.3f} (paper: shifts to tension)")
+            f"Table 2 packing charged to {q:g} e0 against the {' / '.join(sorted(what))} "
+            f"({packings}): F_n/F_C sd {change('Fn_sd', '{:.3f}')}, inside |F_n/F_C| < "
+            f"{paper.FORCE_RANGE:g} {change('Fn_inside', '{:.3f}')} (paper: all), mean "
+            f"{change('Fn_mean', '{:+.5f}')}, tensile share {change('Fn_tensile', '{:.3f}')} "
+            "(paper: shifts to tension)"
+            + (f"; change packing by packing: mean {paired('Fn_mean')}, tensile share "
+               f"{paired('Fn_tensile')}" if n > 1 else ""))
     return lines

@@ -1,6 +1,7 @@
 """One runner for the studies of the command line (``demo`` and ``reproduce``): the depositions
 of a list of cases and seeds (a resumable sweep), runs.csv and summary.csv, the Table 2 check on
-the first neutral packing of the Fig. 2 case, and the figures, all in one folder.
+the first neutral packing of the Fig. 2 case (or on each, :meth:`Study.table2_packings`), and
+the figures, all in one folder.
 
 A study says which runs it wants (:meth:`Study.params`), which particle to follow
 (:meth:`Study.tracer`), the charges of its Table 2 check (:meth:`Study.table2_charges`) and what
@@ -27,6 +28,20 @@ FIG2_CASE = {"rp": DepositionParams.rp, "U0": DepositionParams.U0,
              "gamma": DepositionParams.gamma, "q": 0.0}
 
 
+def table2_folder(out: Path, seed: int | None) -> Path:
+    """Where the Table 2 check of a packing goes: table2/ for the first packing (as before
+    several were checked), table2-s<seed>/ for the others."""
+    return Path(out) / ("table2" if seed is None else f"table2-s{seed}")
+
+
+def table2_folders(out: Path) -> list[Path]:
+    """The Table 2 folders under out: table2/ first, then table2-s<seed>/ by seed."""
+    others = sorted((d for d in Path(out).glob("table2-s*") if d.is_dir()
+                     and d.name[len("table2-s"):].isdigit()),
+                    key=lambda d: int(d.name[len("table2-s"):]))
+    return [d for d in [Path(out) / "table2"] if d.is_dir()] + others
+
+
 @dataclass
 class Study:
     """Depositions for cases and seeds, then tables, the Table 2 check and the figures."""
@@ -50,6 +65,11 @@ class Study:
 
     def table2_charges(self) -> tuple:
         return tuple(self.table2_qs)
+
+    def table2_packings(self, formed: list[dict]) -> list[dict]:
+        """The neutral Fig. 2 packings (sorted by seed) that the Table 2 check charges: the
+        first."""
+        return formed[:1]
 
     def analyse(self, runs, summary, out: Path, results: list[dict]) -> dict:
         """The study's own analyses of the runs (written under out); entries of run()'s result.
@@ -87,14 +107,17 @@ class Study:
                         key=lambda r: r["params"]["seed"])
         qs = self.table2_charges()
         if self.finished_only:
-            t2 = load_table2(out / "table2") if (out / "table2").is_dir() else []
+            for d in table2_folders(out):
+                t2 += load_table2(d)
         elif formed and have_fmm and qs:
             # the Table 2 runs take the formed run's settings (run_table2)
-            try:
-                t2 = run_table2(runner, Path(formed[0]["dir"]), qs, out / "table2",
-                                jobs=self.jobs)
-            except RunError as e:
-                log.error("Table 2 check FAILED: %s", e)
+            for k, r in enumerate(self.table2_packings(formed)):
+                try:
+                    t2 += run_table2(runner, Path(r["dir"]), qs,
+                                     table2_folder(out, None if k == 0 else r["params"]["seed"]),
+                                     jobs=self.jobs)
+                except RunError as e:
+                    log.error("Table 2 check FAILED: %s", e)
         res["table2"] = tables.table2_frame(t2) if t2 else None
         res["table2_rows"] = t2
         res["figures"] = figures.all_figures(results, out / "figures", t2)

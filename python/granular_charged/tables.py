@@ -198,8 +198,10 @@ def adstar_collapse(runs: pd.DataFrame, barrier_fraction: float = 1.0) -> pd.Dat
 
 
 def table2_frame(rows: list[dict]) -> pd.DataFrame:
-    """The charged-after-formation check beside the paper's Table 2 (its N = 2000 packing)."""
+    """The charged-after-formation check beside the paper's Table 2 (its N = 2000 packing), one
+    row per packing (the seed of its deposition) and charge."""
     df = pd.DataFrame(rows)[["q", "phi_before", "phi_after", "Z_before", "Z_after", "FC_over_FE"]]
+    df.insert(0, "seed", [(r.get("params") or {}).get("seed") for r in rows])
     ref = pd.DataFrame(paper.TABLE2, columns=["q", "paper_phi", "paper_Z"])
     df = df.merge(ref, on="q", how="left")
     df["dphi"] = df["phi_after"] - df["phi_before"]

@@ -1,5 +1,7 @@
 """`reproduce --size paper`: the study's runs, their order and their folders, and a report of
 what is finished without running anything."""
+import pytest
+
 from granular_charged import paper
 from granular_charged.reproduce import SIZES, Reproduction, paper_size_params
 from granular_charged.sweep import PAPER_SETS, expand
@@ -42,3 +44,29 @@ def test_finished_only_runs_nothing(cli, tmp_path):
     assert not list((tmp_path / "o").glob("runs/*/log.lammps"))
     assert (tmp_path / "o" / "report.txt").exists()
     assert paper.PHI0_RANGE
+
+
+def test_paper_size_checks_table2_on_every_seeds_packing(tmp_path):
+    from granular_charged.demo import Demo
+    from granular_charged.study import table2_folder, table2_folders
+    formed = [{"params": {"seed": s}} for s in (1, 2, 3)]
+    assert Reproduction(out=".", size_name="paper").table2_packings(formed) == formed
+    assert Reproduction(out=".", size_name="demo").table2_packings(formed) == formed[:1]
+    assert Demo(out=".").table2_packings(formed) == formed[:1]
+    # the first packing's folder is the one a single check always used (kept data stay valid)
+    assert table2_folder(tmp_path, None) == tmp_path / "table2"
+    for name in ("table2-s3", "table2-s10", "table2", "table2-s2", "table2-sx"):
+        (tmp_path / name).mkdir()
+    assert [d.name for d in table2_folders(tmp_path)] == ["table2", "table2-s2", "table2-s3",
+                                                          "table2-s10"]
+
+
+def test_table2_frame_names_each_packings_seed():
+    from granular_charged import tables
+    rows = [{"q": q, "phi_before": 0.4, "phi_after": 0.4 + dq, "Z_before": 3.9, "Z_after": 3.9,
+             "FC_over_FE": 1e4, "params": {"seed": s}}
+            for s in (1, 2) for q, dq in ((0.0, 0.0), (400.0, 1e-5))]
+    t = tables.table2_frame(rows)
+    assert list(t["seed"]) == [1, 1, 2, 2]
+    assert list(t["paper_phi"]) == [paper.TABLE2[0][1], paper.TABLE2[2][1]] * 2
+    assert t["dphi"].tolist() == [0.0, pytest.approx(1e-5), 0.0, pytest.approx(1e-5)]
