@@ -382,15 +382,10 @@ def cmd_demo(a) -> int:
     return 0 if res["complete"] else 1
 
 
-def cmd_epd(a) -> int:
-    from . import epd
-    from .runner import Runner
+def _study_runs(a, params) -> tuple[Path, list[dict]]:
+    """A study of fixed runs (epd, conventions): run what is not finished in OUT/runs (nothing
+    with --finished-only), then the finished runs of the study there (logged when none)."""
     from .sweep import Sweep, load_results
-    _, extra = _vars(a, "epd")
-    params = epd.study_params(tuple(a.seeds))
-    for p in params:
-        p.extra.update(extra)
-        Runner.check(p, 0)
     out = _out_dir(a.out)
     runs = out / "runs"
     if not a.finished_only:
@@ -399,6 +394,19 @@ def cmd_epd(a) -> int:
     results = [r for r in load_results(runs) if r["key"] in keys] if runs.exists() else []
     if not results:
         log.error("no finished runs of the study in %s", runs)
+    return out, results
+
+
+def cmd_epd(a) -> int:
+    from . import epd
+    from .runner import Runner
+    _, extra = _vars(a, "epd")
+    params = epd.study_params(tuple(a.seeds))
+    for p in params:
+        p.extra.update(extra)
+        Runner.check(p, 0)
+    out, results = _study_runs(a, params)
+    if not results:
         return 1
     t = epd.table(results)
     t.to_csv(out / "epd.csv", index=False)
@@ -411,19 +419,12 @@ def cmd_epd(a) -> int:
 def cmd_conventions(a) -> int:
     from . import conventions
     from .runner import Runner
-    from .sweep import Sweep, load_results
     fields, extra = _vars(a, "conventions")
     params = conventions.study_params(tuple(a.seeds), extra=extra, fields=fields)
     for p in params:
         Runner.check(p, 0)
-    out = _out_dir(a.out)
-    runs = out / "runs"
-    if not a.finished_only:
-        Sweep(_runner(a, not a.no_render), runs, jobs=a.jobs, progress=a.progress).run(params)
-    keys = {p.key() for p in params}
-    results = [r for r in load_results(runs) if r["key"] in keys] if runs.exists() else []
+    out, results = _study_runs(a, params)
     if not results:
-        log.error("no finished runs of the study in %s", runs)
         return 1
     t = conventions.case_table(conventions.run_frame(results))
     c = conventions.checks(t)

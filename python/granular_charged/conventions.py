@@ -216,6 +216,13 @@ def verdict(c: pd.DataFrame) -> str:
     return head + f"\npasses all three checks: {names}" + rest
 
 
+def _rolling_axis(ax, thetas):
+    ax.set_xscale("log")
+    ax.set_xticks(thetas, [f"{v:g}" for v in thetas])
+    ax.minorticks_off()
+    ax.set_xlabel("theta_crit (rolling limit)")
+
+
 def figure(t: pd.DataFrame, out) -> "Path | None":
     """phi0_question.png in OUT (beside reproduce's conventions.png, which compares the cases at the
     deck's rolling limit): per phi definition, the neutral phi_0 of the three series against
@@ -240,9 +247,7 @@ def figure(t: pd.DataFrame, out) -> "Path | None":
             d = d.sort_values("theta_crit")
             ax.errorbar(d["theta_crit"], d[col], yerr=d[f"{col}_sd"].fillna(0.0), marker="o",
                         ms=3, capsize=2, label=f"{rp:g} um, {u0:g} m/s")
-        ax.set_xscale("log")
-        ax.set_xticks(thetas, [f"{v:g}" for v in thetas])
-        ax.set_xlabel("theta_crit (rolling limit)")
+        _rolling_axis(ax, thetas)
         ax.set_ylabel("phi_0")
         ax.set_title(f"phi: {name}", fontsize=8)
         if k == 0:
@@ -254,9 +259,7 @@ def figure(t: pd.DataFrame, out) -> "Path | None":
     for name, col in Z_DEFINITIONS.items():
         ax.errorbar(fig2["theta_crit"], fig2[col], yerr=fig2[f"{col}_sd"].fillna(0.0), marker="o",
                     ms=3, capsize=2, label=f"<Z> {name}")
-    ax.set_xscale("log")
-    ax.set_xticks(thetas, [f"{v:g}" for v in thetas])
-    ax.set_xlabel("theta_crit (rolling limit)")
+    _rolling_axis(ax, thetas)
     ax.set_ylabel("<Z>_0, 2 um, 1 m/s")
     ax.legend(fontsize=6)
     out = Path(out)
