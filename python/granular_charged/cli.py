@@ -143,7 +143,9 @@ def build_parser() -> argparse.ArgumentParser:
                             "Table 2 (--quick: under 15 min)",
                        description=REPRODUCE_DESCRIPTION,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
-    _study_options(p, "reproduce", "deck variables for every run (e.g. --var theta_crit 0.04)")
+    _study_options(p, "reproduce", "deck variables for every run (e.g. --var theta_crit 0.04)",
+                   "the tables, claims and figures of the runs finished in --out so far (a "
+                   "study that grows over several sittings)")
     p.add_argument("--size", choices=["demo", "quick", "paper"], default="demo",
                    help="demo: N = 500 in L = 14 r_p (default); quick: N = 200 in L = 9 r_p, "
                         "charges 0 200 300 400 450, Table 2 at 400 only; paper: N = 2000 in "
@@ -151,9 +153,6 @@ def build_parser() -> argparse.ArgumentParser:
                         "to Ad = 20) with the deck's default protocols (many CPU hours)")
     p.add_argument("--quick", action="store_const", const="quick", dest="size",
                    help="the same as --size quick")
-    p.add_argument("--finished-only", action="store_true",
-                   help="run nothing: the tables, claims and figures of the runs finished in "
-                        "--out so far (a study that grows over several sittings)")
 
     p = sub.add_parser("epd", parents=[common],
                        help="the electrophoretic deposition study (doc/epd.md), resumable",
@@ -164,9 +163,8 @@ def build_parser() -> argparse.ArgumentParser:
                                    "directions against the field, mean +- sd over the seeds "
                                    "(printed and in OUT/epd.csv). Resumable; --finished-only "
                                    "tabulates what is finished.")
-    _study_options(p, "epd", "deck variables for every run")
-    p.add_argument("--finished-only", action="store_true",
-                   help="run nothing: the table of the runs finished in --out so far")
+    _study_options(p, "epd", "deck variables for every run",
+                   "the table of the runs finished in --out so far")
 
     p = sub.add_parser("conventions", parents=[common],
                        help="the phi_0 question at paper size: the paper's open conventions "
@@ -183,9 +181,8 @@ def build_parser() -> argparse.ArgumentParser:
                                    "those of `reproduce --size paper` (the same folders under "
                                    "OUT/runs). Resumable; --finished-only tabulates what is "
                                    "finished.")
-    _study_options(p, "conventions", "deck variables for every run")
-    p.add_argument("--finished-only", action="store_true",
-                   help="run nothing: the tables of the runs finished in --out so far")
+    _study_options(p, "conventions", "deck variables for every run",
+                   "the tables of the runs finished in --out so far")
 
     p = sub.add_parser("demo", parents=[common],
                        help="the reduced Fig. 2 study: runs, table, Table 2, figures",
@@ -204,8 +201,10 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
-def _study_options(p: argparse.ArgumentParser, name: str, var_help: str):
-    """Options that demo and reproduce share."""
+def _study_options(p: argparse.ArgumentParser, name: str, var_help: str,
+                   finished_only: str | None = None):
+    """Options that the studies share; finished_only: what --finished-only prints (the study
+    has the option when given)."""
     p.add_argument("--out", default=f"{name}-output", help=f"output folder (default {name}-output)")
     p.add_argument("--seeds", type=_count, nargs="+", default=[1, 2, 3],
                    help="seeds of the injection positions (default 1 2 3)")
@@ -214,6 +213,9 @@ def _study_options(p: argparse.ArgumentParser, name: str, var_help: str):
     p.add_argument("--jobs", type=_count, default=1, help="runs at a time")
     p.add_argument("--np", type=_count, default=1, help="MPI ranks per run")
     p.add_argument("--no-render", action="store_true", help="no rendered packing images")
+    if finished_only:
+        p.add_argument("--finished-only", action="store_true",
+                       help=f"run nothing: {finished_only}")
 
 
 # --var names that something else sets, per command: {name: what sets it}

@@ -27,6 +27,7 @@ The checks, each against numbers printed in the paper's text (module ``paper``),
 from __future__ import annotations
 
 import itertools
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -223,14 +224,12 @@ def _rolling_axis(ax, thetas):
     ax.set_xlabel("theta_crit (rolling limit)")
 
 
-def figure(t: pd.DataFrame, out) -> "Path | None":
+def figure(t: pd.DataFrame, out) -> Path | None:
     """phi0_question.png in OUT (beside reproduce's conventions.png, which compares the cases at the
     deck's rolling limit): per phi definition, the neutral phi_0 of the three series against
     the rolling limit (mean +- sd over the seeds) with the paper's range as a band and its Table
     2 phi_0 as a star at every theta_crit; beside it <Z>_0 of the Table 2 case (slab and all
     particles) with the paper's 3.2056. The plotted means beside it as CSV."""
-    from pathlib import Path
-
     from . import figures as fg
     neutral = t[t["q"] == 0]
     if neutral.empty:
