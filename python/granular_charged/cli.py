@@ -76,6 +76,9 @@ def _deck_options(p: argparse.ArgumentParser, many: bool):
                         "--var L_rp 14 --var farfield average; not those with an option of "
                         "their own (--rp --U0 --gamma --q --N --seed --tracer)")
     p.add_argument("--tracer", type=int, default=0, help="follow this particle id (Fig. 8)")
+    p.add_argument("--checkpoint", type=int, default=0, metavar="K",
+                   help="plane and sequential injection: a restart point every K particles; an "
+                        "interrupted run goes on from its last one when run again (0: none)")
     p.add_argument("--no-render", action="store_true", help="no rendered packing image")
 
 
@@ -264,7 +267,8 @@ def _runner(a, render=True):
     from .lammps_build import LammpsBuild
     from .runner import Runner
     build = LammpsBuild.find(getattr(a, "build_dir", None))
-    return Runner(build, np_ranks=getattr(a, "np", 1), render=render)
+    return Runner(build, np_ranks=getattr(a, "np", 1), render=render,
+                  checkpoint=getattr(a, "checkpoint", 0))
 
 
 def cmd_run(a) -> int:

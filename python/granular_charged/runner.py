@@ -7,7 +7,8 @@ as ``-var`` arguments, then reads phi, <Z>, f(Z) and the run's counters from the
 (``packing.png``, dump image). The parent adds the Python analysis of the final dump (the
 cross-check of the computes) and writes ``result.json`` atomically: a folder with a complete
 ``result.json`` is never run again (resumable sweeps); a folder without one (an interrupted run)
-is emptied and run again.
+is emptied and run again, unless the deck left a restart point there (``checkpoint``, plane and
+sequential injection): then the run goes on from it (doc/deposition.md, "Restart points").
 """
 from __future__ import annotations
 
@@ -35,7 +36,15 @@ log = logging.getLogger(__name__)
 RESULT_VERSION = 3
 # deck variables the runner sets itself (not extra variables of a run)
 RESERVED = {"out": "the run's folder, set by the runner",
-            "tracer": "the runner's tracer argument (--tracer)"}
+            "tracer": "the runner's tracer argument (--tracer)",
+            "checkpoint": "the runner's checkpoint argument (--checkpoint)",
+            "resume": "set by the runner when a run folder holds a restart point",
+            "checkpoint_stop": "a deck variable for tests (it ends a run at a restart point)"}
+# a restart point of in.deposition (its checkpoint variable), and the dumps that follow a run
+CHECKPOINT_FILES = ("checkpoint.restart", "checkpoint.vars")
+FOLLOWING_DUMPS = ("tracer.dump", "traj.dump")
+# the times of the pieces of a run continued from restart points
+PIECES = "pieces.json"
 # what every reader of result.json uses (tables, figures, the studies, the resumption)
 RESULT_KEYS = ("key", "params", "groups", "phi", "Z", "fZ", "inserted", "natoms", "lost",
                "flying", "wall_s")
@@ -127,17 +136,53 @@ def folder_lock(lockfile: Path, what: str):
             fcntl.flock(fh, fcntl.LOCK_UN)
 
 
+def restart_point(workdir: Path) -> dict | None:
+    """The restart point in.deposition left in a run folder: {'k': particles made, 'step':
+    its time step} from checkpoint.vars, or None when the folder has none (or half of one)."""
+    workdir = Path(workdir)
+    if not all((workdir / f).exists() for f in CHECKPOINT_FILES):
+        return None
+    values = {}
+    for line in (workdir / "checkpoint.vars").read_text().splitlines():
+        words = line.split()
+        if len(words) == 4 and words[0] == "variable" and words[2] == "equal":
+            values[words[1]] = words[3]
+    try:
+        return {"k": int(values["ck_k"]), "step": int(values["ck_step"])}
+    except (KeyError, ValueError):
+        return None
+
+
+def trim_dump(path: Path, before_step: int):
+    """Keep the snapshots of a LAMMPS text dump from before a step: a run continued from a
+    restart point at that step writes the later ones again."""
+    path = Path(path)
+    if not path.exists():
+        return
+    blocks = path.read_text().split("ITEM: TIMESTEP\n")
+    keep = [b for b in blocks[1:] if int(b.split("\n", 1)[0]) < before_step]
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text("".join("ITEM: TIMESTEP\n" + b for b in keep))
+    os.replace(tmp, path)
+
+
 class Runner:
-    """Runs decks in folders with one LAMMPS build, ``np_ranks`` MPI ranks per run."""
+    """Runs decks in folders with one LAMMPS build, ``np_ranks`` MPI ranks per run;
+    ``checkpoint`` > 0: plane and sequential depositions leave a restart point every that many
+    particles, from which an interrupted run goes on."""
 
     def __init__(self, build: LammpsBuild, np_ranks: int = 1, timeout: float | None = None,
-                 render: bool = True):
+                 render: bool = True, checkpoint: int = 0):
         if not (isinstance(np_ranks, int) and np_ranks >= 1):
             raise ParamError(f"np_ranks = {np_ranks}: MPI ranks per run must be a whole number >= 1")
+        if not (isinstance(checkpoint, int) and checkpoint >= 0):
+            raise ParamError(f"checkpoint = {checkpoint}: particles between restart points must "
+                             "be a whole number >= 0 (0: none)")
         self.build = build
         self.np_ranks = np_ranks
         self.timeout = timeout
         self.render = render
+        self.checkpoint = checkpoint
 
     # ---- one deck -------------------------------------------------------------------------
     def run_deck(self, deck: str, workdir: Path, variables: dict, kind: str = "none",
@@ -169,7 +214,11 @@ class Runner:
         res_file = workdir / "lammps.json"
         if r.returncode != 0 or not res_file.exists():
             logf = workdir / "log.lammps"
-            tail = "\n".join(logf.read_text(errors="replace").splitlines()[-15:]) if logf.exists() else ""
+            text = logf.read_text(errors="replace") if logf.exists() else ""
+            stop = [ln for ln in text.splitlines() if ln.startswith("GC CHECKPOINT STOP")]
+            if r.returncode == 0 and stop:
+                raise RunError(f"{workdir}: {stop[-1][3:]}; run it again to go on from there")
+            tail = "\n".join(text.splitlines()[-15:])
             raise RunError(f"LAMMPS run in {workdir} failed (exit {r.returncode}):\n{tail}\n"
                            f"{r.stderr[-1500:]}")
         out = json.loads(res_file.read_text())
@@ -215,7 +264,8 @@ class Runner:
             done["dir"] = str(wd)
             log.debug("%s: finished before, skipped", p.key())
             return done
-        if wd.exists():
+        point = None if force else restart_point(wd)
+        if wd.exists() and point is None:
             log.info("%s: incomplete run folder (interrupted?), running it again", p.key())
             shutil.rmtree(wd)
         if p.q and not self.build.capabilities["coul/fmm"]:
@@ -225,8 +275,14 @@ class Runner:
         variables.setdefault("computes", "1" if self.build.capabilities["packing computes"] else "0")
         if tracer:
             variables["tracer"] = str(tracer)
+        pieces = self._begin_piece(wd, point, variables)
         lmp = self.run_deck("in.deposition", wd, variables, kind="deposition",
                             render=self.render and self.build.can_render)
+        pieces[-1].update(wall_s=lmp["wall_s"], cpu_s=lmp["cpu_s"])
+        if len(pieces) > 1:
+            write_json(wd / PIECES, pieces)
+            lmp["wall_s"] = sum(pc["wall_s"] for pc in pieces)
+            lmp["cpu_s"] = sum(pc["cpu_s"] for pc in pieces)
         try:
             res = self.analyse(wd, p, lmp)
         except (OSError, ValueError, KeyError, IndexError, TypeError) as e:
@@ -235,10 +291,47 @@ class Runner:
             raise RunError(f"{p.key()}: the analysis of {wd} failed: {type(e).__name__}: {e}") from e
         res["tracer"] = tracer
         res["np"] = self.np_ranks
+        if len(pieces) > 1:
+            res["pieces"] = pieces
         write_json(wd / "result.json", res)
+        for name in CHECKPOINT_FILES:
+            (wd / name).unlink(missing_ok=True)
         res["skipped"] = False
         res["dir"] = str(wd)
         return res
+
+    def _begin_piece(self, wd: Path, point: dict | None, variables: dict) -> list[dict]:
+        """Set up a run's next piece: from its restart point when it has one (resume yes, the
+        dumps cut back to it, the earlier log kept as log.lammps.<n>), the restart interval
+        (this runner's, else the interrupted piece's); returns the pieces so far, the new one
+        last. An interrupted piece counts up to its last restart point (mtime of checkpoint.vars;
+        its later work is done again), as wall and CPU time alike."""
+        pieces = []
+        if point is not None:
+            with contextlib.suppress(OSError, ValueError):
+                pieces = json.loads((wd / PIECES).read_text())
+            kept_until = (wd / "checkpoint.vars").stat().st_mtime
+            for pc in pieces:
+                if "wall_s" not in pc:
+                    pc["interrupted"] = True
+                    pc["wall_s"] = pc["cpu_s"] = max(0.0, kept_until - pc["start"])
+            variables["resume"] = "yes"
+            for name in FOLLOWING_DUMPS:
+                trim_dump(wd / name, point["step"])
+            if (wd / "log.lammps").exists():
+                os.replace(wd / "log.lammps", wd / f"log.lammps.{len(pieces)}")
+            log.info("%s: going on from its restart point after particle %d (step %d)",
+                     wd.name, point["k"], point["step"])
+        every = self.checkpoint or next((pc["checkpoint"] for pc in reversed(pieces)
+                                         if pc.get("checkpoint")), 0)
+        if every:
+            variables["checkpoint"] = str(every)
+        pieces.append({"from_particle": point["k"] if point else 0, "start": time.time(),
+                       "checkpoint": every})
+        if every:
+            wd.mkdir(parents=True, exist_ok=True)
+            write_json(wd / PIECES, pieces)
+        return pieces
 
     @staticmethod
     def analyse(workdir: Path, p: DepositionParams, lmp: dict) -> dict:

@@ -1,0 +1,112 @@
+"""Restart points of in.deposition (`--checkpoint K`, plane and sequential injection): a run
+killed after a restart point goes on from it when run again, and ends in the same packing, bit
+for bit, as the run that was never interrupted (doc/deposition.md, "Restart points").
+
+Size: N = 25 in L = 6 r_p from H = 60 r_p, one particle at a time at 400 e_0 (charged: fix
+coul/fmm's adaptive time stepping and its restart are part of what must continue), ~5 s per run
+here. Nothing is statistical: the assertions are identities of files."""
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from conftest import SRC
+
+SEQ = ["--N", 25, "--seed", 1, "--q", 400, "--var", "L_rp", 6, "--var", "H_rp", 60,
+       "--var", "inject", "sequential", "--tracer", 20, "--no-render"]
+# the plane rain: the next particle after 2 r_p of fall, the earlier ones still in flight
+PLANE = SEQ[:-4] + ["plane", "--var", "seq_gap_rp", 2, "--tracer", 20, "--no-render"]
+
+
+def _run_dir(root: Path) -> Path:
+    (wd,) = [d for d in root.iterdir() if d.is_dir()]
+    return wd
+
+
+def _popen(build_dir, args, cwd):
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(SRC / "python"), str(Path(build_dir) / "python")])
+    env["GC_BUILD_DIR"] = str(build_dir)
+    return subprocess.Popen([sys.executable, "-m", "granular_charged", *map(str, args)], cwd=cwd,
+                            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+
+
+def _restart_particle(wd: Path) -> int:
+    from granular_charged.runner import restart_point
+    point = restart_point(wd)
+    return point["k"] if point else 0
+
+
+@pytest.mark.parametrize("deck", [SEQ, PLANE], ids=["sequential", "plane"])
+def test_a_killed_run_goes_on_from_its_restart_point(cli, build_dir, tmp_path, deck):
+    """The reference runs with restart points and is never interrupted; the other is killed
+    (SIGKILL to the command and its LAMMPS child) once a restart point at particle 10 or later
+    exists, then run again with the same command. Same final.dump, forces.dump and followed
+    particle (tracer.dump, cut back to the restart point and continued); result.json counts
+    two pieces, the first one interrupted; the restart files are gone afterwards."""
+    ref = tmp_path / "ref"
+    cli(["-q", "run", "--out", ref, "--checkpoint", 5, *deck], cwd=tmp_path)
+    ref_wd = _run_dir(ref)
+
+    cut = tmp_path / "cut"
+    proc = _popen(build_dir, ["-q", "run", "--out", cut, "--checkpoint", 5, *deck], tmp_path)
+    try:
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < 300 and proc.poll() is None:
+            dirs = [d for d in cut.glob("*") if d.is_dir()] if cut.exists() else []
+            if dirs and _restart_particle(dirs[0]) >= 10:
+                break
+            time.sleep(0.02)
+        assert proc.poll() is None, "the run ended before it could be interrupted"
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.communicate()
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    wd = _run_dir(cut)
+    assert not (wd / "result.json").exists()
+    stopped_at = _restart_particle(wd)
+    assert 10 <= stopped_at < 25
+
+    cli(["-q", "run", "--out", cut, "--checkpoint", 5, *deck], cwd=tmp_path)
+    for name in ("final.dump", "forces.dump", "tracer.dump"):
+        assert (wd / name).read_bytes() == (ref_wd / name).read_bytes(), name
+    res = json.loads((wd / "result.json").read_text())
+    pieces = res["pieces"]
+    assert [pc["from_particle"] for pc in pieces] == [0, stopped_at]
+    assert pieces[0]["interrupted"] and "interrupted" not in pieces[1]
+    assert res["cpu_s"] == pytest.approx(sum(pc["cpu_s"] for pc in pieces))
+    assert (wd / "log.lammps.1").exists() and "GC RESULT" in (wd / "log.lammps").read_text()
+    assert not (wd / "checkpoint.restart").exists() and not (wd / "checkpoint.vars").exists()
+
+
+def test_restart_points_leave_the_run_unchanged(cli, tmp_path):
+    """Writing restart points must not perturb the run (LAMMPS's write_restart re-initialises
+    the system unless noinit; with that, fix coul/fmm's adaptive interval took another course
+    after the third restart point here): with and without --checkpoint, the same packing."""
+    cli(["-q", "run", "--out", tmp_path / "a", *SEQ], cwd=tmp_path)
+    cli(["-q", "run", "--out", tmp_path / "b", "--checkpoint", 5, *SEQ], cwd=tmp_path)
+    a, b = _run_dir(tmp_path / "a"), _run_dir(tmp_path / "b")
+    assert a.name == b.name            # the same run: --checkpoint is not a parameter
+    assert (a / "final.dump").read_bytes() == (b / "final.dump").read_bytes()
+
+
+def test_checkpoint_refuses_the_rain(cli, tmp_path):
+    """The rain from H is one LAMMPS run command: no restart points between particles, and the
+    deck says so instead of ignoring the option."""
+    r = cli(["-q", "run", "--out", tmp_path, "--checkpoint", 5, "--N", 5, "--var", "L_rp", 6,
+             "--var", "H_rp", 30, "--no-render"], cwd=tmp_path, check=False)
+    assert r.returncode != 0
+    assert "checkpoint needs inject plane or sequential" in r.stderr
+
+
+def test_checkpoint_must_be_a_count(cli, tmp_path):
+    r = cli(["-q", "run", "--out", tmp_path, "--checkpoint", -1, *SEQ], cwd=tmp_path, check=False)
+    assert r.returncode != 0 and "checkpoint = -1" in r.stderr
+    assert not any(tmp_path.iterdir())
