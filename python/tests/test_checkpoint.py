@@ -97,13 +97,16 @@ def test_restart_points_leave_the_run_unchanged(cli, tmp_path):
     assert (a / "final.dump").read_bytes() == (b / "final.dump").read_bytes()
 
 
-def test_checkpoint_refuses_the_rain(cli, tmp_path):
-    """The rain from H is one LAMMPS run command: no restart points between particles, and the
-    deck says so instead of ignoring the option."""
-    r = cli(["-q", "run", "--out", tmp_path, "--checkpoint", 5, "--N", 5, "--var", "L_rp", 6,
-             "--var", "H_rp", 30, "--no-render"], cwd=tmp_path, check=False)
-    assert r.returncode != 0
-    assert "checkpoint needs inject plane or sequential" in r.stderr
+def test_checkpoint_with_the_rain_is_said(cli, tmp_path):
+    """The rain from H is one LAMMPS run command: no restart points between particles. A study
+    that runs neutral rain beside charged plane or sequential runs gives --checkpoint to all,
+    so the deck says it has no effect (log.lammps) instead of stopping, and writes none."""
+    cli(["-q", "run", "--out", tmp_path, "--checkpoint", 5, "--N", 5, "--var", "L_rp", 6,
+         "--var", "H_rp", 30, "--no-render"], cwd=tmp_path)
+    wd = _run_dir(tmp_path)
+    assert "GC WARNING: checkpoint 5 has no effect with inject rain" in (wd / "log.lammps").read_text()
+    assert json.loads((wd / "result.json").read_text())["natoms"] == 5
+    assert not (wd / "checkpoint.restart").exists()
 
 
 def test_checkpoint_must_be_a_count(cli, tmp_path):
