@@ -123,6 +123,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="folder for the figures")
     p.add_argument("--table2", default=None, metavar="DIR",
                    help="a folder of charged-after-formation runs (demo-output/table2)")
+    p.add_argument("--variant", default=None,
+                   help="when RESULTS holds runs of several variants (N, non-default material "
+                        "or deck variables, e.g. 'N=2000 inject=sequential'): the one to show")
 
     p = sub.add_parser("table2", parents=[common],
                        help="the Table 2 check on a finished neutral run",
@@ -335,14 +338,16 @@ def cmd_sweep(a) -> int:
                         runner.build.path)
         params = [p for p in params if not p.q]
     res = Sweep(runner, out, jobs=a.jobs, progress=a.progress).run(params, a.tracer)
-    if figs is not None:
-        _figures(load_results(out), figs, None)
+    if figs is not None and params:
+        from .tables import variant
+        _figures(load_results(out), figs, None, variant(vars(params[0])))
     return 0 if len(res) == len(params) else 1
 
 
-def _figures(results, out: Path, t2dir: Path | None):
+def _figures(results, out: Path, t2dir: Path | None, variant: str | None = None):
     from . import figures, tables
     from .after_formation import load_table2
+    results = tables.one_variant(results, variant)
     rows = load_table2(t2dir) if t2dir is not None else []
     out.mkdir(parents=True, exist_ok=True)
     if results:
@@ -362,7 +367,7 @@ def cmd_figures(a) -> int:
     if not results:
         log.error("no finished runs (*/result.json) in %s", a.results)
         return 1
-    _figures(results, out, Path(a.table2) if a.table2 else None)
+    _figures(results, out, Path(a.table2) if a.table2 else None, a.variant)
     return 0
 
 

@@ -6,7 +6,46 @@ import pandas as pd
 
 from . import paper
 
-CASE = ("rp_um", "U0", "gamma_mJ", "q")    # a case: everything but the seed
+CASE = ("rp_um", "U0", "gamma_mJ", "q")    # a case of one variant: everything but the seed
+
+
+def _value(v) -> str:
+    try:
+        return f"{float(v):g}"
+    except (TypeError, ValueError):
+        return str(v)
+
+
+def variant(params: dict) -> str:
+    """What a run's case (r_p, U_0, gamma, q) and seed leave out of its parameters, as 'N=2000
+    inject=sequential': N, the material and far-field values that differ from the deck's
+    defaults, the other deck variables. The tables average over the seeds of a case, so they
+    may hold runs of one variant only (a folder can hold several: the paper-size runs, the
+    rolling-limit and the one-at-a-time studies share one)."""
+    from .params import MATERIAL, DepositionParams
+    parts = [f"N={_value(params['N'])}"]
+    parts += [f"{k}={_value(params[k])}" for k in MATERIAL
+              if k in params and params[k] != getattr(DepositionParams, k)]
+    parts += [f"{k}={_value(v)}" for k, v in sorted(params.get("extra", {}).items())]
+    return " ".join(parts)
+
+
+def one_variant(results: list[dict], chosen: str | None = None) -> list[dict]:
+    """The results of one variant: all of them when they are of one, else those of `chosen`;
+    ParamError naming the variants (with their run counts) when several are there and none,
+    or one that is not there, is chosen."""
+    from .params import ParamError
+    groups: dict[str, list[dict]] = {}
+    for r in results:
+        groups.setdefault(variant(r["params"]), []).append(r)
+    if chosen is None and len(groups) <= 1:
+        return list(results)
+    if chosen in groups:
+        return groups[chosen]
+    listed = "; ".join(f"'{v}' ({len(rs)} runs)" for v, rs in sorted(groups.items()))
+    what = (f"--variant '{chosen}' is not among them" if chosen is not None
+            else "their seeds cannot be averaged together: choose one with --variant")
+    raise ParamError(f"the runs are of {len(groups)} variants ({listed}); {what}")
 
 
 def runs_frame(results: list[dict]) -> pd.DataFrame:

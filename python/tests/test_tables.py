@@ -105,3 +105,34 @@ def test_with_uncertainty_prints_the_digits_the_scatter_allows():
     assert tables.with_uncertainty(3.9402, 0.055) == "3.940 +- 0.055"
     assert tables.with_uncertainty(0.0061, 0.019, sig=1) == "0.01 +- 0.02"
     assert tables.with_uncertainty(0.40884, float("nan")) == "0.409"
+
+
+def _params(N=2000, q=0.0, seed=1, extra=None, **material):
+    return {"params": {"rp": 2e-6, "U0": 1.0, "gamma": 0.01, "q": q, "N": N, "seed": seed,
+                       "farfield": "exact", "theta_crit": 0.01, "extra": extra or {}, **material}}
+
+
+def test_variant_names_what_the_case_and_seed_leave_out():
+    assert tables.variant(_params()["params"]) == "N=2000"
+    assert tables.variant(_params(q=400.0, seed=3)["params"]) == "N=2000"
+    assert tables.variant(_params(theta_crit=0.04)["params"]) == "N=2000 theta_crit=0.04"
+    # deck variables as given on the command line (strings) or by a study (numbers) agree
+    assert (tables.variant(_params(N=500, extra={"L_rp": "14", "inject": "rain"})["params"])
+            == tables.variant(_params(N=500, extra={"inject": "rain", "L_rp": 14})["params"])
+            == "N=500 L_rp=14 inject=rain")
+
+
+def test_one_variant_refuses_to_average_several():
+    """A folder with the default paper-size runs and the rolling-limit study's: before, the
+    figures' summary averaged theta_crit 0.04 runs into the default cases."""
+    import pytest
+    from granular_charged.params import ParamError
+    same = [_params(seed=s) for s in (1, 2)] + [_params(q=400.0)]
+    assert tables.one_variant(same) == same
+    mixed = same + [_params(theta_crit=0.04), _params(extra={"inject": "sequential"}, q=400.0)]
+    with pytest.raises(ParamError, match="3 variants.*'N=2000' \\(3 runs\\).*--variant"):
+        tables.one_variant(mixed)
+    assert tables.one_variant(mixed, "N=2000") == same
+    assert tables.one_variant(mixed, "N=2000 theta_crit=0.04") == [mixed[3]]
+    with pytest.raises(ParamError, match="'N=500' is not among them"):
+        tables.one_variant(mixed, "N=500")
