@@ -40,8 +40,9 @@ RESERVED = {"out": "the run's folder, set by the runner",
             "checkpoint": "the runner's checkpoint argument (--checkpoint)",
             "resume": "set by the runner when a run folder holds a restart point",
             "checkpoint_stop": "a deck variable for tests (it ends a run at a restart point)"}
-# a restart point of in.deposition (its checkpoint variable), and the dumps that follow a run
-CHECKPOINT_FILES = ("checkpoint.restart", "checkpoint.vars")
+# a restart point of in.deposition (its checkpoint variable): checkpoint.vars names it (ck_k),
+# checkpoint-<ck_k>.restart holds it; and the dumps that follow a run
+CHECKPOINT_VARS = "checkpoint.vars"
 FOLLOWING_DUMPS = ("tracer.dump", "traj.dump")
 # the times of the pieces of a run continued from restart points
 PIECES = "pieces.json"
@@ -138,19 +139,21 @@ def folder_lock(lockfile: Path, what: str):
 
 def restart_point(workdir: Path) -> dict | None:
     """The restart point in.deposition left in a run folder: {'k': particles made, 'step':
-    its time step} from checkpoint.vars, or None when the folder has none (or half of one)."""
+    its time step} from checkpoint.vars, or None when the folder has none (or its restart file
+    is missing)."""
     workdir = Path(workdir)
-    if not all((workdir / f).exists() for f in CHECKPOINT_FILES):
+    if not (workdir / CHECKPOINT_VARS).exists():
         return None
     values = {}
-    for line in (workdir / "checkpoint.vars").read_text().splitlines():
+    for line in (workdir / CHECKPOINT_VARS).read_text().splitlines():
         words = line.split()
         if len(words) == 4 and words[0] == "variable" and words[2] == "equal":
             values[words[1]] = words[3]
     try:
-        return {"k": int(values["ck_k"]), "step": int(values["ck_step"])}
+        point = {"k": int(values["ck_k"]), "step": int(values["ck_step"])}
     except (KeyError, ValueError):
         return None
+    return point if (workdir / f"checkpoint-{point['k']}.restart").exists() else None
 
 
 def trim_dump(path: Path, before_step: int):
@@ -294,8 +297,8 @@ class Runner:
         if len(pieces) > 1:
             res["pieces"] = pieces
         write_json(wd / "result.json", res)
-        for name in CHECKPOINT_FILES:
-            (wd / name).unlink(missing_ok=True)
+        for path in wd.glob("checkpoint*"):
+            path.unlink(missing_ok=True)
         res["skipped"] = False
         res["dir"] = str(wd)
         return res
@@ -310,7 +313,7 @@ class Runner:
         if point is not None:
             with contextlib.suppress(OSError, ValueError):
                 pieces = json.loads((wd / PIECES).read_text())
-            kept_until = (wd / "checkpoint.vars").stat().st_mtime
+            kept_until = (wd / CHECKPOINT_VARS).stat().st_mtime
             for pc in pieces:
                 if "wall_s" not in pc:
                     pc["interrupted"] = True
