@@ -98,13 +98,27 @@ def _draw_spheres(ax, snap, Z, view_axis=1):
     ax.set_aspect("equal")
 
 
+def packing_image_names(results: list[dict]) -> list[str]:
+    """The file name of each run's packing image: packing_q<q>_s<seed>.png when the runs are of
+    one series (r_p, U_0, gamma), else with the series in front, packing_rp<r_p>um_U<U_0>_g
+    <gamma>mJ_q<q>_s<seed>.png (with the short names, the nine neutral cases of the paper-size
+    study wrote one file, packing_q0_s1.png, in turn)."""
+    def series(p):
+        return f"rp{p['rp'] * 1e6:g}um_U{p['U0']:g}_g{p['gamma'] * 1e3:g}mJ_"
+    several = len({series(r["params"]) for r in results}) > 1
+    return [f"packing_{series(r['params']) if several else ''}q{r['params']['q']:g}"
+            f"_s{r['params']['seed']}.png" for r in results]
+
+
 def packing_image(result: dict, out: Path, name: str | None = None) -> Path:
     """The final packing at true sphere size coloured by Z with a colour bar: LAMMPS's render
     (packing.png of the run, dump image) framed with matplotlib; the fallback renderer when the
     build could not render."""
+    name = name or packing_image_names([result])[0]
     p = result["params"]
-    name = name or f"packing_q{p['q']:g}_s{p['seed']}.png"
     fig = new_figure(5.6, 5.0)
+    fig.suptitle(f"r_p = {p['rp'] * 1e6:g} um, U_0 = {p['U0']:g} m/s, gamma = "
+                 f"{p['gamma'] * 1e3:g} mJ/m^2, seed {p['seed']}", fontsize=9)
     ax = fig.add_subplot(111)
     packing_panel(fig, ax, result)
     z_colorbar(fig, ax)
@@ -589,8 +603,8 @@ def all_figures(results, out: Path, table2_rows: list[dict] | None = None,
         log.warning("figures: no finished runs")
         return []
     ok = _ok(results)
-    for r in ok:
-        paths.append(packing_image(r, out))
+    for r, name in zip(ok, packing_image_names(ok)):
+        paths.append(packing_image(r, out, name))
     paths.append(packings_panel(results, out))
     p = phi_vs_q(results, out)
     paths += list(p) if isinstance(p, tuple) else [p]
