@@ -450,50 +450,56 @@ def cmd_epd(a) -> int:
     return 0 if a.finished_only or len(results) == len(params) else 1
 
 
-def cmd_conventions(a) -> int:
-    from . import conventions
+def _checked_study(a, command: str, study_params):
+    """The runs of a study of fixed runs: its parameters (study_params(seeds, extra=, fields=)
+    with the --var pairs checked for the command), each checked, then _study_runs; returns
+    (out, params, results)."""
     from .runner import Runner
-    fields, extra = _vars(a, "conventions")
-    params = conventions.study_params(tuple(a.seeds), extra=extra, fields=fields)
+    fields, extra = _vars(a, command)
+    params = study_params(tuple(a.seeds), extra=extra, fields=fields)
     for p in params:
         Runner.check(p, 0)
     out, results = _study_runs(a, params)
+    return out, params, results
+
+
+def _study_report(a, out: Path, name: str, params, results, *parts: str) -> int:
+    """Print a study's report (how many runs are finished, then its parts), write it to
+    OUT/<name>.txt; the exit status: 0 when every run is finished or with --finished-only."""
+    text = "\n\n".join([f"{len(results)} of {len(params)} runs finished", *parts])
+    (out / f"{name}.txt").write_text(text + "\n")
+    print(text)
+    return 0 if a.finished_only or len(results) == len(params) else 1
+
+
+def cmd_conventions(a) -> int:
+    from . import conventions
+    out, params, results = _checked_study(a, "conventions", conventions.study_params)
     if not results:
         return 1
     t = conventions.case_table(conventions.run_frame(results))
     c = conventions.checks(t)
     t.to_csv(out / "conventions.csv", index=False)
     c.to_csv(out / "conventions_checks.csv", index=False)
-    text = "\n\n".join([f"{len(results)} of {len(params)} runs finished",
-                         conventions.format_cases(t), conventions.format_checks(c),
-                         conventions.verdict(c)])
-    (out / "conventions.txt").write_text(text + "\n")
-    print(text)
+    status = _study_report(a, out, "conventions", params, results, conventions.format_cases(t),
+                           conventions.format_checks(c), conventions.verdict(c))
     path = conventions.figure(t, out / "figures")
     if path:
         print(f"figure: {path}")
-    return 0 if a.finished_only or len(results) == len(params) else 1
+    return status
 
 
 def cmd_one_at_a_time(a) -> int:
     from . import one_at_a_time as study
-    from .runner import Runner
-    fields, extra = _vars(a, "one-at-a-time")
-    params = study.study_params(tuple(a.seeds), extra=extra, fields=fields)
-    for p in params:
-        Runner.check(p, 0)
-    out, results = _study_runs(a, params)
+    out, params, results = _checked_study(a, "one-at-a-time", study.study_params)
     if not results:
         return 1
     t = study.case_table(study.run_frame(results))
     d = study.differences(t)
     t.to_csv(out / "one_at_a_time.csv", index=False)
     d.to_csv(out / "one_at_a_time_differences.csv", index=False)
-    text = "\n\n".join([f"{len(results)} of {len(params)} runs finished", study.format_table(t),
-                         study.format_differences(d)])
-    (out / "one_at_a_time.txt").write_text(text + "\n")
-    print(text)
-    return 0 if a.finished_only or len(results) == len(params) else 1
+    return _study_report(a, out, "one_at_a_time", params, results, study.format_table(t),
+                         study.format_differences(d))
 
 
 COMMANDS = {"run": cmd_run, "sweep": cmd_sweep, "figures": cmd_figures, "table2": cmd_table2,
