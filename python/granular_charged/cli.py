@@ -160,19 +160,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quick", action="store_const", const="quick", dest="size",
                    help="the same as --size quick")
 
-    p = sub.add_parser("epd", parents=[common],
+    p = _fixed_study_parser(sub, common, "epd", "the table of the runs finished in --out so far",
                        help="the electrophoretic deposition study (doc/epd.md), resumable",
                        description="Charged particles (2 um, 1 m/s, 10 mJ/m^2, 400 e0) driven by "
                                    "an applied field onto a grounded floor electrode, E0 = 1e5 and "
                                    "3e5 V/m, eps_p = 0 (not polarisable) and 3.8, N = 500 in "
                                    "L = 14 r_p, three seeds: phi, <Z>, f(Z) and the contact "
                                    "directions against the field, mean +- sd over the seeds "
-                                   "(printed and in OUT/epd.csv). Resumable; --finished-only "
-                                   "tabulates what is finished.")
-    _study_options(p, "epd", "deck variables for every run",
-                   "the table of the runs finished in --out so far")
+                                   "(printed and in OUT/epd.csv).")
 
-    p = sub.add_parser("conventions", parents=[common],
+    p = _fixed_study_parser(sub, common, "conventions",
+                       "the tables of the runs finished in --out so far",
                        help="the phi_0 question at paper size: the paper's open conventions "
                             "(doc/reproduction.md), resumable",
                        description="Which convention the paper leaves open gives its Table 2, "
@@ -185,12 +183,10 @@ def build_parser() -> argparse.ArgumentParser:
                                    "(OUT/conventions.csv) and the checks per convention "
                                    "(OUT/conventions_checks.csv). The theta_crit 0.01 runs are "
                                    "those of `reproduce --size paper` (the same folders under "
-                                   "OUT/runs). Resumable; --finished-only tabulates what is "
-                                   "finished.")
-    _study_options(p, "conventions", "deck variables for every run",
-                   "the tables of the runs finished in --out so far")
+                                   "OUT/runs).")
 
-    p = sub.add_parser("one-at-a-time", parents=[common],
+    p = _fixed_study_parser(sub, common, "one-at-a-time",
+                       "the tables of the runs finished in --out so far",
                        help="the one-at-a-time limit at paper size against the default plane "
                             "rain (doc/reproduction.md), resumable",
                        description="inject sequential (each particle once the previous one has "
@@ -202,10 +198,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "those of `reproduce --size paper` (the same folders under "
                                    "OUT/runs). A sequential run is hours of CPU: it leaves a "
                                    "restart point every --checkpoint particles and an "
-                                   "interrupted one goes on from there. Resumable; "
-                                   "--finished-only tabulates what is finished.")
-    _study_options(p, "one-at-a-time", "deck variables for every run",
-                   "the tables of the runs finished in --out so far")
+                                   "interrupted one goes on from there.")
     p.add_argument("--checkpoint", type=int, default=50, metavar="K",
                    help="particles between restart points (default 50; 0: none)")
 
@@ -241,6 +234,17 @@ def _study_options(p: argparse.ArgumentParser, name: str, var_help: str,
     if finished_only:
         p.add_argument("--finished-only", action="store_true",
                        help=f"run nothing: {finished_only}")
+
+
+def _fixed_study_parser(sub, common, name: str, finished_only: str, help: str,
+                        description: str) -> argparse.ArgumentParser:
+    """The parser of a study of fixed runs (epd, conventions, one-at-a-time): resumable, with
+    the studies' options and --finished-only printing `finished_only`."""
+    p = sub.add_parser(name, parents=[common], help=help,
+                       description=description + " Resumable; --finished-only tabulates what "
+                                                 "is finished.")
+    _study_options(p, name, "deck variables for every run", finished_only)
+    return p
 
 
 # --var names that something else sets, per command: {name: what sets it}

@@ -103,8 +103,10 @@ def packing_image_names(results: list[dict]) -> list[str]:
     one series (r_p, U_0, gamma), else with the series in front, packing_rp<r_p>um_U<U_0>_g
     <gamma>mJ_q<q>_s<seed>.png (with the short names, the nine neutral cases of the paper-size
     study wrote one file, packing_q0_s1.png, in turn)."""
+    from .params import series_name
+
     def series(p):
-        return f"rp{p['rp'] * 1e6:g}um_U{p['U0']:g}_g{p['gamma'] * 1e3:g}mJ_"
+        return series_name(p["rp"], p["U0"], p["gamma"]) + "_"
     several = len({series(r["params"]) for r in results}) > 1
     return [f"packing_{series(r['params']) if several else ''}q{r['params']['q']:g}"
             f"_s{r['params']['seed']}.png" for r in results]

@@ -73,8 +73,7 @@ class DepositionParams:
     def key(self) -> str:
         """A file-system friendly name, unique for the parameters: the swept ones always, the
         far field of a charged run, and every other one that differs from its default."""
-        base = (f"rp{self.rp * 1e6:g}um_U{self.U0:g}_g{self.gamma * 1e3:g}mJ_q{self.q:g}"
-                f"_N{self.N}_s{self.seed}")
+        base = f"{series_name(self.rp, self.U0, self.gamma)}_q{self.q:g}_N{self.N}_s{self.seed}"
         if self.q:
             base += f"_{self.farfield}"
         tags = {k: getattr(self, k) for k in MATERIAL
@@ -101,6 +100,11 @@ class DepositionParams:
         d = dimensionless(self.gamma, self.rho, self.U0, self.rp, self.q, K_eff=K)
         d["K_eff"] = K
         return d
+
+
+def series_name(rp: float, U0: float, gamma: float) -> str:
+    """A series (r_p, U_0, gamma) as file names write it: rp2um_U1_g10mJ."""
+    return f"rp{rp * 1e6:g}um_U{U0:g}_g{gamma * 1e3:g}mJ"
 
 
 def param_names() -> tuple:
