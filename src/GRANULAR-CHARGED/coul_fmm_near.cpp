@@ -11,6 +11,8 @@
 
 #include "coul_fmm_time_stepping.h"
 
+#include "gcfmm/charge_pair_change.hpp"
+
 #include "atom.h"
 #include "comm.h"
 #include "domain.h"
@@ -21,12 +23,15 @@
 #include "neigh_request.h"
 #include "neighbor.h"
 
+#include <algorithm>
+
 using namespace LAMMPS_NS;
 using MTS = CoulFMMTimeStepping;
 
 CoulFMMNearRefresh::CoulFMMNearRefresh(LAMMPS *lmp, Fix *owner) :
     Pointers(lmp), fix(owner), list(nullptr), delta(nullptr), near_now(nullptr), near_then(nullptr),
-    nmax_delta(0), nmax_out(0)
+    nmax_delta(0), nmax_out(0), pair_now{}, pair_then{}, pair_dg{}, pair_r2now(nullptr),
+    pair_r2then(nullptr), simd_path(gcfmm::default_simd_path())
 {
 }
 
@@ -75,20 +80,57 @@ void CoulFMMNearRefresh::compute(const MTS &scheme, double **eval_state, bool in
     MTS::displacements(xu, eval_state[i], delta[i]);
   }
   comm->forward_comm(fix);
+  for (int i = 0; i < nlocal; i++)
+    for (int k = 0; k < 4; k++) out[i][k] = 0.0;
+
+  // the pairs of charged atoms of the group in the list's order: their separations now and at
+  // the evaluation, then the kernel differences of all of them in one call (SIMD), then the
+  // sums in the same order as pair by pair
+  auto pair_ok = [&](int j) { return (mask[j] & groupbit) && q[j] != 0.0; };
+  int npairs = 0;
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    if (pair_ok(i)) npairs += list->numneigh[i];
+  }
+  grow_pairs(npairs);
+  int p = 0;
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    if (!pair_ok(i)) continue;
+    for (int jj = 0; jj < list->numneigh[i]; jj++) {
+      const int j = list->firstneigh[i][jj] & NEIGHMASK;
+      if (!pair_ok(j)) continue;
+      double now[3], then[3];
+      for (int k = 0; k < 3; k++) now[k] = x[i][k] - x[j][k];
+      MTS::separation_then(now, delta[i], delta[j], then);
+      for (int k = 0; k < 3; k++) {
+        pair_now[k][p] = now[k];
+        pair_then[k][p] = then[k];
+      }
+      p++;
+    }
+  }
+  gcfmm::charge_pair_change(p, {pair_now[0], pair_now[1], pair_now[2]},
+                            {pair_then[0], pair_then[1], pair_then[2]},
+                            {pair_dg[0], pair_dg[1], pair_dg[2], pair_dg[3], pair_r2now, pair_r2then},
+                            simd_path);
+
   // each pair once: at i from j q_j dg, at j from i -q_i dg (field) and q_i dg (potential). A
   // ghost j is a local atom elsewhere (or an image here) whose own list holds the pair the
   // other way round: only i is updated.
-  for (int i = 0; i < nlocal; i++)
-    for (int k = 0; k < 4; k++) out[i][k] = 0.0;
+  p = 0;
   for (int ii = 0; ii < list->inum; ii++) {
     const int i = list->ilist[ii];
-    if (!(mask[i] & groupbit) || q[i] == 0.0) continue;
-    double e[4] = {0.0, 0.0, 0.0, 0.0}, dg[4];
+    if (!pair_ok(i)) continue;
+    double e[4] = {0.0, 0.0, 0.0, 0.0};
     for (int jj = 0; jj < list->numneigh[i]; jj++) {
       const int j = list->firstneigh[i][jj] & NEIGHMASK;
-      if (!(mask[j] & groupbit) || q[j] == 0.0) continue;
-      const double now[3] = {x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]};
-      if (!scheme.near_pair_change(now, delta[i], delta[j], trend, dg)) continue;
+      if (!pair_ok(j)) continue;
+      const double now[3] = {pair_now[0][p], pair_now[1][p], pair_now[2][p]};
+      double dg[4] = {pair_dg[0][p], pair_dg[1][p], pair_dg[2][p], pair_dg[3][p]};
+      const double rn2 = pair_r2now[p], rt2 = pair_r2then[p];
+      p++;
+      if (!scheme.near_pair_finish(now, rn2, rt2, delta[i], delta[j], trend, dg)) continue;
       for (int k = 0; k < 4; k++) e[k] += q[j] * dg[k];
       if (j < nlocal) {
         for (int k = 0; k < 3; k++) out[j][k] -= q[i] * dg[k];
@@ -100,6 +142,20 @@ void CoulFMMNearRefresh::compute(const MTS &scheme, double **eval_state, bool in
   const double c = force->qqrd2e;
   for (int i = 0; i < nlocal; i++)
     for (int k = 0; k < 4; k++) out[i][k] *= c;
+}
+
+// twelve arrays of n (at least one, so that the pointers are valid for n = 0)
+void CoulFMMNearRefresh::grow_pairs(int n)
+{
+  const std::size_t cap = std::max<std::size_t>(n, 1);
+  if (pair_buffer.size() >= 12 * cap) return;
+  pair_buffer.assign(12 * cap, 0.0);
+  double *b = pair_buffer.data();
+  for (auto &a : pair_now) a = b, b += cap;
+  for (auto &a : pair_then) a = b, b += cap;
+  for (auto &a : pair_dg) a = b, b += cap;
+  pair_r2now = b;
+  pair_r2then = b + cap;
 }
 
 int CoulFMMNearRefresh::pack(int n, int *list_send, double *buf) const
@@ -119,5 +175,6 @@ void CoulFMMNearRefresh::unpack(int n, int first, const double *buf)
 
 double CoulFMMNearRefresh::memory_usage() const
 {
-  return ((double) MTS::DELTA_COLS * nmax_delta + 8.0 * nmax_out) * sizeof(double);
+  return ((double) MTS::DELTA_COLS * nmax_delta + 8.0 * nmax_out + pair_buffer.size()) *
+      sizeof(double);
 }

@@ -17,6 +17,10 @@
 
 #include "pointers.h"
 
+#include "gcfmm/simd.hpp"
+
+#include <vector>
+
 namespace LAMMPS_NS {
 class CoulFMMTimeStepping;
 
@@ -46,6 +50,12 @@ class CoulFMMNearRefresh : protected Pointers {
   class NeighList *list;
   double **delta, **near_now, **near_then;
   int nmax_delta, nmax_out;
+  // the pairs of one compute() as arrays (gcfmm::charge_pair_change): separations now and at
+  // the evaluation, the kernel differences and the squared separations, in pair_buffer
+  std::vector<double> pair_buffer;
+  double *pair_now[3], *pair_then[3], *pair_dg[4], *pair_r2now, *pair_r2then;
+  gcfmm::SimdPath simd_path;
+  void grow_pairs(int n);
 };
 
 }    // namespace LAMMPS_NS

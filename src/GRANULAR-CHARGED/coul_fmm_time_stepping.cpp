@@ -9,6 +9,8 @@
 
 #include "coul_fmm_time_stepping.h"
 
+#include "gcfmm/charge_pair_change.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -164,36 +166,27 @@ void CoulFMMTimeStepping::finish_evaluation(const Plan &p, double error)
 bool CoulFMMTimeStepping::near_pair_change(const double now[3], const double *di, const double *dj,
                                            double trend, double dg[4]) const
 {
-  const double cutsq = set.near_cutoff * set.near_cutoff;
-  double then[3];
-  for (int k = 0; k < 3; k++) then[k] = now[k] - (di[DELTA_E + k] - dj[DELTA_E + k]);
-  // refreshed: the pairs now closer than the cutoff and, between evaluations (trend >= 0),
-  // also those that were at the last evaluation (their change is in no slope). The sets
-  // depend on positions only (not on when a neighbor list was built), so split runs agree.
-  const double rn2 = dot(now, now), rt2 = dot(then, then);
-  if (rn2 >= cutsq && (trend < 0.0 || rt2 >= cutsq)) return false;
-  if (rn2 == 0.0 || rt2 == 0.0) return false;    // coincident atoms are caught at evaluations
-  const double in = 1.0 / std::sqrt(rn2), it = 1.0 / std::sqrt(rt2);
-  const double sn = in * in * in, st = it * it * it;
-  for (int k = 0; k < 3; k++) dg[k] = sn * now[k] - st * then[k];
-  dg[3] = in - it;
-  // a pair that was beyond the cutoff at the later evaluation of the slope has its trend in
-  // the slope: take it out, the pair is summed exactly (doc/theory.md, eq. (5.3))
-  if (trend > 0.0 && di[DELTA_IN_SLOPE] != 0.0 && dj[DELTA_IN_SLOPE] != 0.0) {
-    double rb[3], ra[3];
-    for (int k = 0; k < 3; k++) {
-      rb[k] = now[k] - (di[DELTA_B + k] - dj[DELTA_B + k]);
-      ra[k] = now[k] - (di[DELTA_A + k] - dj[DELTA_A + k]);
-    }
-    const double rb2 = dot(rb, rb), ra2 = dot(ra, ra);
-    if (rb2 >= cutsq && ra2 > 0.0) {
-      const double ib = 1.0 / std::sqrt(rb2), ia = 1.0 / std::sqrt(ra2);
-      const double sb = trend * ib * ib * ib, sa = trend * ia * ia * ia;
-      for (int k = 0; k < 3; k++) dg[k] -= sb * rb[k] - sa * ra[k];
-      dg[3] -= trend * (ib - ia);
-    }
-  }
+  double then[3], change[4], rn2, rt2;
+  separation_then(now, di, dj, then);
+  gcfmm::charge_pair_change(1, {&now[0], &now[1], &now[2]}, {&then[0], &then[1], &then[2]},
+                            {&change[0], &change[1], &change[2], &change[3], &rn2, &rt2});
+  if (!near_pair_finish(now, rn2, rt2, di, dj, trend, change)) return false;
+  for (int k = 0; k < 4; k++) dg[k] = change[k];
   return true;
+}
+
+void CoulFMMTimeStepping::remove_trend(const double now[3], const double rb[3], const double *di,
+                                       const double *dj, double trend, double dg[4]) const
+{
+  double ra[3];
+  for (int k = 0; k < 3; k++) ra[k] = now[k] - (di[DELTA_A + k] - dj[DELTA_A + k]);
+  const double rb2 = dot(rb, rb), ra2 = dot(ra, ra);
+  if (ra2 > 0.0) {
+    const double ib = 1.0 / std::sqrt(rb2), ia = 1.0 / std::sqrt(ra2);
+    const double sb = trend * ib * ib * ib, sa = trend * ia * ia * ia;
+    for (int k = 0; k < 3; k++) dg[k] -= sb * rb[k] - sa * ra[k];
+    dg[3] -= trend * (ib - ia);
+  }
 }
 
 void CoulFMMTimeStepping::displacements(const double xu[3], const double *state, double *delta)

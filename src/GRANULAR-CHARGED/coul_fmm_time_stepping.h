@@ -120,6 +120,17 @@ class CoulFMMTimeStepping {
   // of the pairs the slope carries. False (dg untouched) if the pair is not refreshed.
   bool near_pair_change(const double now[3], const double *di, const double *dj, double trend,
                         double dg[4]) const;
+  // the same in two halves, for many pairs at once (the near refresh): the separation at the
+  // evaluation, then (after gcfmm::charge_pair_change gave dg = (K, 1/r)(now) - (K, 1/r)(then)
+  // and the squared separations rn2, rt2) whether the pair is refreshed and its trend taken out
+  // (inline: the near refresh calls them for every pair at every step)
+  static void separation_then(const double now[3], const double *di, const double *dj,
+                              double then[3])
+  {
+    for (int k = 0; k < 3; k++) then[k] = now[k] - (di[DELTA_E + k] - dj[DELTA_E + k]);
+  }
+  bool near_pair_finish(const double now[3], double rn2, double rt2, const double *di,
+                        const double *dj, double trend, double dg[4]) const;
   // an atom's Delta row from its unwrapped position now and its state
   static void displacements(const double xu[3], const double *state, double *delta);
 
@@ -160,6 +171,11 @@ class CoulFMMTimeStepping {
   bool read_restart(const double *list);
 
  private:
+  // near_pair_finish for a pair beyond the cutoff at the slope's later end (rb): minus trend
+  // times the pair's change over the slope's interval
+  void remove_trend(const double now[3], const double rb[3], const double *di, const double *dj,
+                    double trend, double dg[4]) const;
+
   Settings set;
   int interval;          // evaluations on the steps that are multiples of it
   double estimate;       // error measured at the last evaluation that continued a field
@@ -183,6 +199,26 @@ inline uint64_t coul_fmm_charge_hash(int64_t tag, double q)
   uint64_t bits;
   std::memcpy(&bits, &q, sizeof(bits));
   return coul_fmm_mix64((uint64_t) tag ^ coul_fmm_mix64(bits));
+}
+
+// refreshed: the pairs now closer than the cutoff and, between evaluations (trend >= 0), also
+// those that were at the last evaluation (their change is in no slope). The sets depend on
+// positions only (not on when a neighbor list was built), so split runs agree.
+inline bool CoulFMMTimeStepping::near_pair_finish(const double now[3], double rn2, double rt2,
+                                                  const double *di, const double *dj,
+                                                  double trend, double dg[4]) const
+{
+  const double cutsq = set.near_cutoff * set.near_cutoff;
+  if (rn2 >= cutsq && (trend < 0.0 || rt2 >= cutsq)) return false;
+  if (rn2 == 0.0 || rt2 == 0.0) return false;    // coincident atoms are caught at evaluations
+  // a pair that was beyond the cutoff at the later evaluation of the slope has its trend in
+  // the slope: take it out, the pair is summed exactly (doc/theory.md, eq. (5.3))
+  if (trend > 0.0 && di[DELTA_IN_SLOPE] != 0.0 && dj[DELTA_IN_SLOPE] != 0.0) {
+    double rb[3];
+    for (int k = 0; k < 3; k++) rb[k] = now[k] - (di[DELTA_B + k] - dj[DELTA_B + k]);
+    if (rb[0] * rb[0] + rb[1] * rb[1] + rb[2] * rb[2] >= cutsq) remove_trend(now, rb, di, dj, trend, dg);
+  }
+  return true;
 }
 
 }    // namespace LAMMPS_NS
