@@ -144,11 +144,12 @@ void CoulFMMNearRefresh::compute(const MTS &scheme, double **eval_state, bool in
     for (int k = 0; k < 4; k++) out[i][k] *= c;
 }
 
-// twelve arrays of n (at least one, so that the pointers are valid for n = 0)
+// twelve arrays of at least n (and at least one, so that the pointers are valid for n = 0);
+// grown by half again at least, as the pair count creeps up with a growing bed
 void CoulFMMNearRefresh::grow_pairs(int n)
 {
-  const std::size_t cap = std::max<std::size_t>(n, 1);
-  if (pair_buffer.size() >= 12 * cap) return;
+  if (pair_buffer.size() >= 12 * std::max<std::size_t>(n, 1)) return;
+  const std::size_t cap = std::max<std::size_t>(n, pair_buffer.size() / 12 * 3 / 2 + 1);
   pair_buffer.assign(12 * cap, 0.0);
   double *b = pair_buffer.data();
   for (auto &a : pair_now) a = b, b += cap;
