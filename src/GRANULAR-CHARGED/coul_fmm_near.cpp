@@ -83,23 +83,22 @@ void CoulFMMNearRefresh::compute(const MTS &scheme, double **eval_state, bool in
   for (int i = 0; i < nlocal; i++)
     for (int k = 0; k < 4; k++) out[i][k] = 0.0;
 
-  // the pairs of charged atoms of the group in the list's order: their separations now and at
-  // the evaluation, then the kernel differences of all of them in one call (SIMD), then the
-  // sums in the same order as pair by pair
-  auto pair_ok = [&](int j) { return (mask[j] & groupbit) && q[j] != 0.0; };
+  // the pairs of charged atoms of the group in the list's order (their j and, per i, where
+  // they end): their separations now and at the evaluation, then the kernel differences of all
+  // of them in one call (SIMD), then the sums in the same order as pair by pair
+  auto charged = [&](int j) { return (mask[j] & groupbit) && q[j] != 0.0; };
   int npairs = 0;
-  for (int ii = 0; ii < list->inum; ii++) {
-    const int i = list->ilist[ii];
-    if (pair_ok(i)) npairs += list->numneigh[i];
-  }
+  for (int ii = 0; ii < list->inum; ii++)
+    if (charged(list->ilist[ii])) npairs += list->numneigh[list->ilist[ii]];
   grow_pairs(npairs);
+  pair_i.clear();
   int p = 0;
   for (int ii = 0; ii < list->inum; ii++) {
     const int i = list->ilist[ii];
-    if (!pair_ok(i)) continue;
+    if (!charged(i)) continue;
     for (int jj = 0; jj < list->numneigh[i]; jj++) {
       const int j = list->firstneigh[i][jj] & NEIGHMASK;
-      if (!pair_ok(j)) continue;
+      if (!charged(j)) continue;
       double now[3], then[3];
       for (int k = 0; k < 3; k++) now[k] = x[i][k] - x[j][k];
       MTS::separation_then(now, delta[i], delta[j], then);
@@ -107,8 +106,9 @@ void CoulFMMNearRefresh::compute(const MTS &scheme, double **eval_state, bool in
         pair_now[k][p] = now[k];
         pair_then[k][p] = then[k];
       }
-      p++;
+      pair_j[p++] = j;
     }
+    pair_i.push_back({i, p});
   }
   gcfmm::charge_pair_change(p, {pair_now[0], pair_now[1], pair_now[2]},
                             {pair_then[0], pair_then[1], pair_then[2]},
@@ -119,18 +119,15 @@ void CoulFMMNearRefresh::compute(const MTS &scheme, double **eval_state, bool in
   // ghost j is a local atom elsewhere (or an image here) whose own list holds the pair the
   // other way round: only i is updated.
   p = 0;
-  for (int ii = 0; ii < list->inum; ii++) {
-    const int i = list->ilist[ii];
-    if (!pair_ok(i)) continue;
+  for (const auto &[i, end] : pair_i) {
     double e[4] = {0.0, 0.0, 0.0, 0.0};
-    for (int jj = 0; jj < list->numneigh[i]; jj++) {
-      const int j = list->firstneigh[i][jj] & NEIGHMASK;
-      if (!pair_ok(j)) continue;
+    for (; p < end; p++) {
+      const int j = pair_j[p];
       const double now[3] = {pair_now[0][p], pair_now[1][p], pair_now[2][p]};
       double dg[4] = {pair_dg[0][p], pair_dg[1][p], pair_dg[2][p], pair_dg[3][p]};
-      const double rn2 = pair_r2now[p], rt2 = pair_r2then[p];
-      p++;
-      if (!scheme.near_pair_finish(now, rn2, rt2, delta[i], delta[j], trend, dg)) continue;
+      if (!scheme.near_pair_finish(now, pair_r2now[p], pair_r2then[p], delta[i], delta[j], trend,
+                                   dg))
+        continue;
       for (int k = 0; k < 4; k++) e[k] += q[j] * dg[k];
       if (j < nlocal) {
         for (int k = 0; k < 3; k++) out[j][k] -= q[i] * dg[k];
@@ -157,6 +154,7 @@ void CoulFMMNearRefresh::grow_pairs(int n)
   for (auto &a : pair_dg) a = b, b += cap;
   pair_r2now = b;
   pair_r2then = b + cap;
+  pair_j.resize(cap);
 }
 
 int CoulFMMNearRefresh::pack(int n, int *list_send, double *buf) const
@@ -177,5 +175,6 @@ void CoulFMMNearRefresh::unpack(int n, int first, const double *buf)
 double CoulFMMNearRefresh::memory_usage() const
 {
   return ((double) MTS::DELTA_COLS * nmax_delta + 8.0 * nmax_out + pair_buffer.size()) *
-      sizeof(double);
+      sizeof(double) + (double) pair_j.size() * sizeof(int) +
+      (double) pair_i.capacity() * sizeof(pair_i[0]);
 }

@@ -19,6 +19,7 @@
 
 #include "gcfmm/simd.hpp"
 
+#include <utility>
 #include <vector>
 
 namespace LAMMPS_NS {
@@ -54,6 +55,8 @@ class CoulFMMNearRefresh : protected Pointers {
   // the evaluation, the kernel differences and the squared separations, in pair_buffer
   std::vector<double> pair_buffer;
   double *pair_now[3], *pair_then[3], *pair_dg[4], *pair_r2now, *pair_r2then;
+  std::vector<int> pair_j;                      // the pairs' second atoms
+  std::vector<std::pair<int, int>> pair_i;      // each first atom and the end of its pairs
   gcfmm::SimdPath simd_path;
   void grow_pairs(int n);
 };

@@ -175,12 +175,13 @@ bool CoulFMMTimeStepping::near_pair_change(const double now[3], const double *di
   return true;
 }
 
-void CoulFMMTimeStepping::remove_trend(const double now[3], const double rb[3], const double *di,
-                                       const double *dj, double trend, double dg[4]) const
+void CoulFMMTimeStepping::remove_trend(const double now[3], const double rb[3], double rb2,
+                                       const double *di, const double *dj, double trend,
+                                       double dg[4]) const
 {
   double ra[3];
   for (int k = 0; k < 3; k++) ra[k] = now[k] - (di[DELTA_A + k] - dj[DELTA_A + k]);
-  const double rb2 = dot(rb, rb), ra2 = dot(ra, ra);
+  const double ra2 = dot(ra, ra);
   if (ra2 > 0.0) {
     const double ib = 1.0 / std::sqrt(rb2), ia = 1.0 / std::sqrt(ra2);
     const double sb = trend * ib * ib * ib, sa = trend * ia * ia * ia;

@@ -171,10 +171,10 @@ class CoulFMMTimeStepping {
   bool read_restart(const double *list);
 
  private:
-  // near_pair_finish for a pair beyond the cutoff at the slope's later end (rb): minus trend
+  // near_pair_finish for a pair beyond the cutoff at the slope's later end (rb, rb2 = |rb|^2): minus trend
   // times the pair's change over the slope's interval
-  void remove_trend(const double now[3], const double rb[3], const double *di, const double *dj,
-                    double trend, double dg[4]) const;
+  void remove_trend(const double now[3], const double rb[3], double rb2, const double *di,
+                    const double *dj, double trend, double dg[4]) const;
 
   Settings set;
   int interval;          // evaluations on the steps that are multiples of it
@@ -216,7 +216,8 @@ inline bool CoulFMMTimeStepping::near_pair_finish(const double now[3], double rn
   if (trend > 0.0 && di[DELTA_IN_SLOPE] != 0.0 && dj[DELTA_IN_SLOPE] != 0.0) {
     double rb[3];
     for (int k = 0; k < 3; k++) rb[k] = now[k] - (di[DELTA_B + k] - dj[DELTA_B + k]);
-    if (rb[0] * rb[0] + rb[1] * rb[1] + rb[2] * rb[2] >= cutsq) remove_trend(now, rb, di, dj, trend, dg);
+    const double rb2 = rb[0] * rb[0] + rb[1] * rb[1] + rb[2] * rb[2];
+    if (rb2 >= cutsq) remove_trend(now, rb, rb2, di, dj, trend, dg);
   }
   return true;
 }
