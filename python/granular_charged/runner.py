@@ -137,10 +137,10 @@ def folder_lock(lockfile: Path, what: str):
             fcntl.flock(fh, fcntl.LOCK_UN)
 
 
-def restart_point(workdir: Path) -> dict | None:
+def restart_point(workdir: Path, suffix: str = "") -> dict | None:
     """The restart point in.deposition left in a run folder: {'k': particles made, 'step':
     its time step} from checkpoint.vars, or None when the folder has none (or its restart file
-    is missing)."""
+    is missing; suffix ".gz": a point kept compressed, scripts/keep_runs.py)."""
     workdir = Path(workdir)
     if not (workdir / CHECKPOINT_VARS).exists():
         return None
@@ -153,7 +153,7 @@ def restart_point(workdir: Path) -> dict | None:
         point = {"k": int(values["ck_k"]), "step": int(values["ck_step"])}
     except (KeyError, ValueError):
         return None
-    return point if (workdir / f"checkpoint-{point['k']}.restart").exists() else None
+    return point if (workdir / f"checkpoint-{point['k']}.restart{suffix}").exists() else None
 
 
 def trim_dump(path: Path, before_step: int):

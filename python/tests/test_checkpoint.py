@@ -43,6 +43,25 @@ def _restart_particle(wd: Path) -> int:
     return point["k"] if point else 0
 
 
+def _kill_after_a_point(build_dir, deck, out: Path, cwd: Path, at: int = 10):
+    """Start the run with restart points every 5 particles and SIGKILL the command and its
+    LAMMPS child once a point at particle `at` or later exists."""
+    proc = _popen(build_dir, ["-q", "run", "--out", out, "--checkpoint", 5, *deck], cwd)
+    try:
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < 300 and proc.poll() is None:
+            dirs = [d for d in out.glob("*") if d.is_dir()] if out.exists() else []
+            if dirs and _restart_particle(dirs[0]) >= at:
+                break
+            time.sleep(0.02)
+        assert proc.poll() is None, "the run ended before it could be interrupted"
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.communicate()
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+
+
 @pytest.mark.parametrize("deck", [SEQ, PLANE], ids=["sequential", "plane"])
 def test_a_killed_run_goes_on_from_its_restart_point(cli, build_dir, tmp_path, deck):
     """The reference runs with restart points and is never interrupted; the other is killed
@@ -55,20 +74,7 @@ def test_a_killed_run_goes_on_from_its_restart_point(cli, build_dir, tmp_path, d
     ref_wd = _run_dir(ref)
 
     cut = tmp_path / "cut"
-    proc = _popen(build_dir, ["-q", "run", "--out", cut, "--checkpoint", 5, *deck], tmp_path)
-    try:
-        t0 = time.monotonic()
-        while time.monotonic() - t0 < 300 and proc.poll() is None:
-            dirs = [d for d in cut.glob("*") if d.is_dir()] if cut.exists() else []
-            if dirs and _restart_particle(dirs[0]) >= 10:
-                break
-            time.sleep(0.02)
-        assert proc.poll() is None, "the run ended before it could be interrupted"
-        os.killpg(proc.pid, signal.SIGKILL)
-        proc.communicate()
-    finally:
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGKILL)
+    _kill_after_a_point(build_dir, deck, cut, tmp_path)
     wd = _run_dir(cut)
     assert not (wd / "result.json").exists()
     stopped_at = _restart_particle(wd)
@@ -113,3 +119,39 @@ def test_checkpoint_must_be_a_count(cli, tmp_path):
     r = cli(["-q", "run", "--out", tmp_path, "--checkpoint", -1, *SEQ], cwd=tmp_path, check=False)
     assert r.returncode != 0 and "checkpoint = -1" in r.stderr
     assert not any(tmp_path.iterdir())
+
+
+def test_a_kept_restart_point_goes_on_in_another_folder(cli, build_dir, tmp_path):
+    """scripts/keep_runs.py --points keeps an unfinished run's restart point (compressed, its
+    interrupted piece closed); --unpack-points puts it into another study folder (as on another
+    machine after a git checkout), where the same command finishes the run as the uninterrupted
+    one did, bit for bit. Keeping it again after the run finished drops the kept point."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("keep_runs", SRC / "scripts" / "keep_runs.py")
+    keep_runs = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(keep_runs)
+
+    ref = tmp_path / "ref"
+    cli(["-q", "run", "--out", ref, "--checkpoint", 5, *SEQ], cwd=tmp_path)
+    cut = tmp_path / "cut"
+    _kill_after_a_point(build_dir, SEQ, cut, tmp_path)
+    stopped_at = _restart_particle(_run_dir(cut))
+    kept = tmp_path / "kept"
+    assert keep_runs.keep_points(cut, kept) == 1
+    assert keep_runs.keep_points(cut, kept) == 0          # the same point: nothing new
+    (kept_run,) = [d for d in kept.iterdir() if d.is_dir()]
+    assert (kept_run / f"checkpoint-{stopped_at}.restart.gz").exists()
+    assert json.loads((kept_run / "pieces.json").read_text())[0]["interrupted"]
+
+    other = tmp_path / "other"
+    assert keep_runs.unpack_points(kept, other) == 1
+    assert keep_runs.unpack_points(kept, other) == 0      # already there
+    cli(["-q", "run", "--out", other, "--checkpoint", 5, *SEQ], cwd=tmp_path)
+    wd, ref_wd = _run_dir(other), _run_dir(ref)
+    for name in ("final.dump", "forces.dump", "tracer.dump"):
+        assert (wd / name).read_bytes() == (ref_wd / name).read_bytes(), name
+    pieces = json.loads((wd / "result.json").read_text())["pieces"]
+    assert [pc["from_particle"] for pc in pieces] == [0, stopped_at]
+    assert pieces[0]["interrupted"] and pieces[0]["wall_s"] > 0
+
+    assert keep_runs.keep_points(other, kept) == 0 and not kept_run.exists()
