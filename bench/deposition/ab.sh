@@ -27,5 +27,10 @@ for tag in before after; do
   phi=$(sed -n 's/^GC RESULT .* phi \([^ ]*\) Z \([^ ]*\).*/\1, <Z> \2/p' "$out/$tag/log.lammps" | tail -n 1)
   echo "$tag: $(tail -n 1 "$out/$tag/user") s user CPU, $steps steps, phi $phi"
 done
+if cmp -s "$out/before/final.dump" "$out/after/final.dump"; then
+  echo "final.dump: identical"
+else
+  echo "final.dump: differs"
+fi
 awk -v a="$(tail -n 1 "$out/after/user")" -v b="$(tail -n 1 "$out/before/user")" 'BEGIN {printf "after / before %.3f\n", a/b}'
 rm -rf "$out"

@@ -7,7 +7,13 @@
    the GNU General Public License (same terms as LAMMPS).
 ------------------------------------------------------------------------- */
 
+// Compiled with -ffp-contract=off -fno-math-errno -fno-trapping-math (CMakeLists.txt): the
+// batched root must give the scalar one's result on every path (no fused multiply-adds), and
+// GCC vectorises the guarded square root only without errno and traps.
 #include "jkr_scaled.h"
+
+#include "gcfmm/simd.hpp"
+#include "gcfmm/simd_paths.hpp"
 
 #include <array>
 #include <cmath>
@@ -22,13 +28,13 @@ constexpr int N_INTERVALS = 1024;
 constexpr double U_MAX = 16.0;
 constexpr double H = U_MAX / N_INTERVALS;
 
-double residual(double s, double Delta)
+GCFMM_ALWAYS_INLINE double residual(double s, double Delta)
 {
   return s * (s * s * s - 4.0) - 3.0 * Delta;
 }
 
 // one Newton step on g(s) = s^4 - 4 s - 3 Delta; g' = 4 (s^3 - 1) > 0 for s > 1
-double newton_step(double s, double Delta)
+GCFMM_ALWAYS_INLINE double newton_step(double s, double Delta)
 {
   const double slope = 4.0 * (s * s * s - 1.0);
   return slope > 0.0 ? s - residual(s, Delta) / slope : s;
@@ -54,6 +60,41 @@ const std::array<Node, N_INTERVALS + 2> &table()
   }();
   return s_of_u;
 }
+
+// Cubic Hermite interpolation in u on the table, then one Newton step (root(), below, says why
+// that is accurate); u < U_MAX
+GCFMM_ALWAYS_INLINE double table_root(const Node *t, double u, double Delta)
+{
+  const double x = u * (1.0 / H);
+  const long i = static_cast<long>(x);    // long: GCC vectorises the gather with 64-bit indices
+  const double f = x - i;
+  const Node &a = t[i], &b = t[i + 1];
+  // Hermite form s = a.s + f (a.slope + f (c2 + f c3))
+  const double ds = b.s - a.s;
+  const double c2 = 3.0 * ds - 2.0 * a.slope - b.slope;
+  const double c3 = a.slope + b.slope - 2.0 * ds;
+  const double s = a.s + f * (a.slope + f * (c2 + f * c3));
+  return newton_step(s, Delta);
+}
+
+// root()'s table branch for every element (one outside the table, u >= U_MAX, is computed at
+// u = 0 here and replaced by the caller)
+GCFMM_ALWAYS_INLINE void roots_loop(std::size_t n, const double *__restrict Delta,
+                                    double *__restrict out, const Node *__restrict t)
+{
+#pragma omp simd
+  for (std::size_t k = 0; k < n; ++k) {
+    const double Delta_k = Delta[k];
+    const bool attached = Delta_k > -1.0;
+    const double u = std::sqrt(attached ? Delta_k + 1.0 : 0.0);
+    const double s = table_root(t, u < U_MAX ? u : 0.0, Delta_k);
+    out[k] = attached ? s : 1.0;
+  }
+}
+
+#define GC_ROOTS_PARAMS (std::size_t n, const double *Delta, double *out, const Node *t)
+#define GC_ROOTS_ARGS (n, Delta, out, t)
+GCFMM_DEFINE_SIMD_PATHS(void, roots_kernel, GC_ROOTS_PARAMS, roots_loop, GC_ROOTS_ARGS)
 
 }    // namespace
 
@@ -88,17 +129,7 @@ double root(double Delta)
   const double u = std::sqrt(Delta + 1.0);
   double s;
   if (u < U_MAX) {
-    const auto &t = table();
-    const double x = u * (1.0 / H);
-    const int i = static_cast<int>(x);
-    const double f = x - i;
-    const Node &a = t[i], &b = t[i + 1];
-    // Hermite form s = a.s + f (a.slope + f (c2 + f c3))
-    const double ds = b.s - a.s;
-    const double c2 = 3.0 * ds - 2.0 * a.slope - b.slope;
-    const double c3 = a.slope + b.slope - 2.0 * ds;
-    s = a.s + f * (a.slope + f * (c2 + f * c3));
-    s = newton_step(s, Delta);
+    s = table_root(table().data(), u, Delta);
   } else {
     // s^4 = 3 Delta + 4 s: one fixed-point pass from (3 Delta)^(1/4) leaves ~1e-4 (the map
     // contracts by 1 / s^3 < 0.007), three Newton steps finish
@@ -107,6 +138,21 @@ double root(double Delta)
     for (int it = 0; it < 3; ++it) s = newton_step(s, Delta);
   }
   return s;
+}
+
+void roots(std::size_t n, const double *Delta, double *s, gcfmm::SimdPath path)
+{
+  if (!gcfmm::simd_path_available(path)) path = gcfmm::SimdPath::Generic;
+  roots_kernel_for(path)(n, Delta, s, table().data());
+  // beyond the table (Delta >= U_MAX^2 - 1 = 255; from 254, clear of sqrt's rounding): root()
+  for (std::size_t k = 0; k < n; ++k)
+    if (Delta[k] >= U_MAX * U_MAX - 2.0) s[k] = root(Delta[k]);
+}
+
+void roots(std::size_t n, const double *Delta, double *s)
+{
+  static const gcfmm::SimdPath path = gcfmm::default_simd_path();
+  roots(n, Delta, s, path);
 }
 
 }    // namespace JKRScaled

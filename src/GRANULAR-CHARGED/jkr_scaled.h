@@ -17,12 +17,26 @@
 #ifndef LMP_GC_JKR_SCALED_H
 #define LMP_GC_JKR_SCALED_H
 
+#include <cstddef>
+
+namespace gcfmm {
+enum class SimdPath;    // gcfmm/simd.hpp: the instruction-set paths of the batched root
+}
+
 namespace LAMMPS_NS {
 namespace JKRScaled {
 
   // The stable root s >= 1 of s^4 - 4 s = 3 Delta for Delta = delta / delta_C >= -1
   // (Delta < -1 is clamped to -1, s = 1). Accurate to a few units in the last place.
   double root(double Delta);
+
+  // s[k] = root(Delta[k]) for k < n in one call, vectorised where the instruction set allows
+  // (the table lookup needs a gather); every path gives root()'s result bit for bit. The pair
+  // style gathers its contacts' Delta and solves them together: one root alone is a chain of
+  // dependent operations (sqrt, table load, Newton division) that a vector of them hides.
+  void roots(std::size_t n, const double *Delta, double *s);
+  // the same on a given path (tests and benchmarks; an unavailable path falls back to generic)
+  void roots(std::size_t n, const double *Delta, double *s, gcfmm::SimdPath path);
 
   // The same root by bisection (slow; for the table and for tests).
   double root_by_bisection(double Delta);

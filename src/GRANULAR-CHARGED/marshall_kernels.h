@@ -86,15 +86,33 @@ namespace MarshallKernels {
     double sqrt_kn;     // sqrt(k_N), k_N = 4/3 E* a: the normal stiffness the damping scales with
   };
 
+  // Delta = delta / delta_C: the overlap of the scaled law (jkr_scaled.h) whose root s gives a
+  inline double scaled_overlap(const JKRScales &sc, double delta)
+  {
+    return delta * sc.inv_deltac;
+  }
+
   // JKR contact radius on the stable branch, a = a_sep s^2 with s^4 - 4 s = 3 delta / delta_C
   // (eq. (1.4a); jkr_scaled.h), and F_ne = 4 F_C ((a/a_0)^3 - (a/a_0)^(3/2))
-  // = F_C (s^6 / 9 - 2 s^3 / 3)  (Marshall 2009, eq. 8). Without adhesion Hertz's law:
-  // a = sqrt(delta R), F_ne = 4 E* a^3 / (3 R).
+  // = F_C (s^6 / 9 - 2 s^3 / 3)  (Marshall 2009, eq. 8), from the root s
+  inline NormalForce jkr_normal_force_of_root(const JKRScales &sc, double s)
+  {
+    NormalForce n;
+    n.a = sc.asep * s * s;
+    n.adhesive = JKRScaled::adhesive_over_fc(s) * sc.fc;
+    n.fne = JKRScaled::force_over_fc(s) * sc.fc;
+    n.pulloff = sc.fc;
+    n.sqrt_kn = s * sc.sqrt_kn_sep;
+    return n;
+  }
+
+  // the same from the overlap delta; without adhesion Hertz's law: a = sqrt(delta R),
+  // F_ne = 4 E* a^3 / (3 R)
   inline NormalForce jkr_normal_force(const JKRScales &sc, double gamma, double emix,
                                       double delta, double reff)
   {
-    NormalForce n;
     if (gamma == 0.0) {
+      NormalForce n;
       const double dR = delta * reff;
       n.a = sqrt(dR > 0.0 ? dR : 0.0);
       n.fne = 4.0 / 3.0 * emix * n.a * n.a * n.a / reff;
@@ -103,13 +121,7 @@ namespace MarshallKernels {
       n.sqrt_kn = sqrt(4.0 / 3.0 * emix * n.a);
       return n;
     }
-    const double s = JKRScaled::root(delta * sc.inv_deltac);
-    n.a = sc.asep * s * s;
-    n.adhesive = JKRScaled::adhesive_over_fc(s) * sc.fc;
-    n.fne = JKRScaled::force_over_fc(s) * sc.fc;
-    n.pulloff = sc.fc;
-    n.sqrt_kn = s * sc.sqrt_kn_sep;
-    return n;
+    return jkr_normal_force_of_root(sc, JKRScaled::root(scaled_overlap(sc, delta)));
   }
 
   // F_crit = |F_ne + 2 F_C|: the normal load the friction limits scale with (paper eq. 4;

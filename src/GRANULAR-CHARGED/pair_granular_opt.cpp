@@ -180,6 +180,11 @@ void PairGranularOpt::compute(int eflag, int vflag)
   const int nactive = asleep ? static_cast<int>(active.size()) : inum;
   bigint contacts = 0;
 
+  // pass 1: the pairs that interact, in list order, their contact life decided (touch and
+  // history of an ended contact reset); the adhesive fused contacts' scaled overlaps collected
+  contact_i.clear();
+  contact_jj.clear();
+  jkr_overlap.clear();
   for (int aa = 0; aa < nactive; aa++) {
     const int ii = asleep ? active[aa] : aa;
     const int i = ilist[ii];
@@ -191,181 +196,207 @@ void PairGranularOpt::compute(int eflag, int vflag)
 
     for (int jj = 0; jj < jnum; jj++) {
       int j = jlist[jj];
-      const double factor_lj = special_lj[sbmask(j)];
+      if (special_lj[sbmask(j)] == 0) continue;
       j &= NEIGHMASK;
-      if (factor_lj == 0) continue;
-          if (asleep && asleep[i] != 0.0 && asleep[j] != 0.0) continue;
-
-      const int jtype = type[j];
-      const int imodel = types_indices[itype][jtype];
-      GranularModel *model = models_list[imodel];
-      double *history = use_history ? &allhistory[size_hist * jj] : nullptr;
-
-      double forces[3], torquesi[3], torquesj[3], dx[3];
+      if (asleep && asleep[i] != 0.0 && asleep[j] != 0.0) continue;
+      const int imodel = types_indices[itype][type[j]];
       if (fused[imodel].on) {
         FusedMarshall &fm = fused[imodel];
-
         // contact geometry and life (GranularModel::check_contact, jkr/marshall touch)
+        double dx[3];
         sub3(x[i], x[j], dx);
         const double rsq = lensq3(dx);
-        const double radi = radius[i];
-        const double radj = radius[j];
-        const double radsum = radi + radj;
+        const double radsum = radius[i] + radius[j];
         // most neighbors of a deposition do not touch: reject those before R_eff and the scales
         // (their history is zero already: zeroed when the contact ended, or new from the list)
         if (!touch[jj] && rsq >= radsum * radsum) continue;
-        if (radi != fm.radi || radj != fm.radj) {
-          fm.radi = radi;
-          fm.radj = radj;
-          fm.reff = radi * radj / radsum;
-          MK::use_jkr_scales(fm.scales, fm.reff, fm.gamma, fm.emix);
-        }
-        const double reff = fm.reff;
+        use_radii(fm, radius[i], radius[j]);
         if (!MK::jkr_touch(touch[jj] != 0, rsq, radsum, fm.scales.deltac)) {
           touch[jj] = 0;
+          double *history = &allhistory[size_hist * jj];
           for (int k = 0; k < size_hist; k++) history[k] = 0.0;
           continue;
         }
         touch[jj] = 1;
-
-        const double mi = rmass[i];
-        const double mj = rmass[j];
-        if (mi != fm.mi || mj != fm.mj) {
-          fm.mi = mi;
-          fm.mj = mj;
-          fm.meff = mi * mj / (mi + mj);
-        }
-        double meff = fm.meff;
-        if (mask[i] & freeze_group_bit) meff = mj;
-        if (mask[j] & freeze_group_bit) meff = mi;
-        if (asleep) sleeper_mass(asleep[i], asleep[j], mi, mj, meff);
-        if (meff != fm.sqrt_mass_of) {
-          fm.sqrt_mass_of = meff;
-          fm.sqrt_mass = MK::damping_sqrt_mass(fm.mass_factor, meff);
-        }
-        const double dt = model->dt;
-
-        // kinematics (GranularModel::calculate_forces)
-        const double r = sqrt(rsq);
-        const double rinv = 1.0 / r;
-        const double delta = radsum - r;
-        double vr[3], nx[3], vn[3], vt[3], wr[3], temp[3], vtr[3];
-        sub3(v[i], v[j], vr);
-        scale3(rinv, dx, nx);
-        const double vnnr = dot3(vr, nx);
-        scale3(vnnr, nx, vn);
-        sub3(vr, vn, vt);
-        scaleadd3(radi, omega[i], radj, omega[j], wr);
-        cross3(wr, nx, temp);
-        sub3(vt, temp, vtr);
-
-        // normal: JKR with Marshall damping
-        const MK::NormalForce nf = MK::jkr_normal_force(fm.scales, fm.gamma, fm.emix, delta, reff);
-        const double damp_prefactor = MK::damping_prefactor(fm.alpha, fm.sqrt_mass, nf);
-        const double fntot = nf.fne + (-damp_prefactor * vnnr);
-        const double fncrit = MK::critical_force(nf);
-
-        // sliding
-        double fs[3];
-        MK::tangential_force(&history[hist_tangential], nx, vtr, dt, fm.k_t * nf.a,
-                             damp_prefactor, fncrit * fm.mu, history_update, fs);
-
-        scale3(fntot, nx, forces);
-        add3(forces, fs, forces);
-        cross3(nx, fs, torquesi);
-        scale3(-1, torquesi);
-        copy3(torquesi, torquesj);
-        scale3(radi - 0.5 * delta, torquesi);
-        scale3(radj - 0.5 * delta, torquesj);
-
-        if (fm.rolling || fm.twisting) {
-          double relrot[3];
-          sub3(omega[i], omega[j], relrot);
-          if (fm.rolling) {
-            // rolling velocity, eq. 31 of Wang et al, Particuology 23, 49 (2015)
-            double vrl[3], fr[3], torroll[3];
-            vrl[0] = reff * (relrot[1] * nx[2] - relrot[2] * nx[1]);
-            vrl[1] = reff * (relrot[2] * nx[0] - relrot[0] * nx[2]);
-            vrl[2] = reff * (relrot[0] * nx[1] - relrot[1] * nx[0]);
-            MK::rolling_force(&history[hist_rolling], nx, vrl, dt,
-                              fm.theta_crit * (fm.roll_radius_factor * reff), nf.adhesive / reff,
-                              history_update, fr);
-            cross3(nx, fr, torroll);
-            scale3(reff, torroll);
-            add3(torquesi, torroll, torquesi);
-            sub3(torquesj, torroll, torquesj);
-          }
-          if (fm.twisting) {
-            // omega_T (eq. 29 of Marshall 2009)
-            const double magtwist = dot3(relrot, nx);
-            const double moment = MK::twisting_moment(history[hist_twisting], magtwist, dt, nf.a,
-                                                      fm.k_t, damp_prefactor, fm.mu * fncrit,
-                                                      history_update);
-            double tortwist[3];
-            scale3(moment, nx, tortwist);
-            add3(torquesi, tortwist, torquesi);
-            sub3(torquesj, tortwist, torquesj);
-          }
-        }
-      } else {
-        // PairGranular's sub-model path for this pair
-        model->xi = x[i];
-        model->xj = x[j];
-        model->radi = radius[i];
-        model->radj = radius[j];
-        model->i = i;
-        model->j = j;
-        model->itype = itype;
-        model->jtype = jtype;
-        if (use_history) model->touch = touch[jj];
-        if (!model->check_contact()) {
-          if (use_history) {
-            touch[jj] = 0;
-            for (int k = 0; k < size_hist; k++) history[k] = 0.0;
-          }
-          continue;
-        }
-        if (use_history) touch[jj] = 1;
-
-        const double mi = rmass[i];
-        const double mj = rmass[j];
-        double meff = mi * mj / (mi + mj);
-        if (mask[i] & freeze_group_bit) meff = mj;
-        if (mask[j] & freeze_group_bit) meff = mi;
-        if (asleep) sleeper_mass(asleep[i], asleep[j], mi, mj, meff);
-        model->meff = meff;
-        model->vi = v[i];
-        model->vj = v[j];
-        model->omegai = omega[i];
-        model->omegaj = omega[j];
-        model->history = history;
-        model->calculate_forces();
-        copy3(model->forces, forces);
-        copy3(model->torquesi, torquesi);
-        copy3(model->torquesj, torquesj);
-        copy3(model->dx, dx);
+        if (fm.gamma != 0.0) jkr_overlap.push_back(MK::scaled_overlap(fm.scales, radsum - sqrt(rsq)));
       }
+      contact_i.push_back(i);
+      contact_jj.push_back(jj);
+    }
+  }
 
-      // apply forces & torques
-      contacts++;
-      scale3(factor_lj, forces);
-      add3(f[i], forces, f[i]);
-      scale3(factor_lj, torquesi);
-      add3(torque[i], torquesi, torque[i]);
-      if (newton_pair || j < nlocal) {
-        sub3(f[j], forces, f[j]);
-        scale3(factor_lj, torquesj);
-        add3(torque[j], torquesj, torque[j]);
+  // the JKR roots of all adhesive contacts in one vectorised call
+  jkr_root.resize(jkr_overlap.size());
+  JKRScaled::roots(jkr_overlap.size(), jkr_overlap.data(), jkr_root.data());
+
+  // pass 2: the forces, pair by pair in list order (the sums of the one-pass loop)
+  std::size_t next_root = 0;
+  const std::size_t npairs = contact_i.size();
+  for (std::size_t c = 0; c < npairs; c++) {
+    const int i = contact_i[c];
+    const int jj = contact_jj[c];
+    const int itype = type[i];
+    int *touch = use_history ? firsttouch[i] : nullptr;
+    double *allhistory = use_history ? firsthistory[i] : nullptr;
+    int j = firstneigh[i][jj];
+    const double factor_lj = special_lj[sbmask(j)];
+    j &= NEIGHMASK;
+
+    const int jtype = type[j];
+    const int imodel = types_indices[itype][jtype];
+    GranularModel *model = models_list[imodel];
+    double *history = use_history ? &allhistory[size_hist * jj] : nullptr;
+
+    double forces[3], torquesi[3], torquesj[3], dx[3];
+    if (fused[imodel].on) {
+      FusedMarshall &fm = fused[imodel];
+      sub3(x[i], x[j], dx);
+      const double rsq = lensq3(dx);
+      const double radi = radius[i];
+      const double radj = radius[j];
+      const double radsum = radi + radj;
+      use_radii(fm, radi, radj);
+      const double reff = fm.reff;
+
+      const double mi = rmass[i];
+      const double mj = rmass[j];
+      if (mi != fm.mi || mj != fm.mj) {
+        fm.mi = mi;
+        fm.mj = mj;
+        fm.meff = mi * mj / (mi + mj);
       }
-      if (evflag)
-        ev_tally_xyz(i, j, nlocal, newton_pair, 0.0, 0.0, forces[0], forces[1], forces[2], dx[0],
-                     dx[1], dx[2]);
-      if (asleep) {
-        ncontact[i] += 1.0;
-        if (newton_pair || j < nlocal) ncontact[j] += 1.0;
-        if (asleep[i] != 0.0) add3(push[i], forces, push[i]);
-        if (asleep[j] != 0.0 && (newton_pair || j < nlocal)) sub3(push[j], forces, push[j]);
+      double meff = fm.meff;
+      if (mask[i] & freeze_group_bit) meff = mj;
+      if (mask[j] & freeze_group_bit) meff = mi;
+      if (asleep) sleeper_mass(asleep[i], asleep[j], mi, mj, meff);
+      if (meff != fm.sqrt_mass_of) {
+        fm.sqrt_mass_of = meff;
+        fm.sqrt_mass = MK::damping_sqrt_mass(fm.mass_factor, meff);
       }
+      const double dt = model->dt;
+
+      // kinematics (GranularModel::calculate_forces)
+      const double r = sqrt(rsq);
+      const double rinv = 1.0 / r;
+      const double delta = radsum - r;
+      double vr[3], nx[3], vn[3], vt[3], wr[3], temp[3], vtr[3];
+      sub3(v[i], v[j], vr);
+      scale3(rinv, dx, nx);
+      const double vnnr = dot3(vr, nx);
+      scale3(vnnr, nx, vn);
+      sub3(vr, vn, vt);
+      scaleadd3(radi, omega[i], radj, omega[j], wr);
+      cross3(wr, nx, temp);
+      sub3(vt, temp, vtr);
+
+      // normal: JKR with Marshall damping (the root from pass 1)
+      const MK::NormalForce nf = (fm.gamma != 0.0)
+          ? MK::jkr_normal_force_of_root(fm.scales, jkr_root[next_root++])
+          : MK::jkr_normal_force(fm.scales, fm.gamma, fm.emix, delta, reff);
+      const double damp_prefactor = MK::damping_prefactor(fm.alpha, fm.sqrt_mass, nf);
+      const double fntot = nf.fne + (-damp_prefactor * vnnr);
+      const double fncrit = MK::critical_force(nf);
+
+      // sliding
+      double fs[3];
+      MK::tangential_force(&history[hist_tangential], nx, vtr, dt, fm.k_t * nf.a,
+                           damp_prefactor, fncrit * fm.mu, history_update, fs);
+
+      scale3(fntot, nx, forces);
+      add3(forces, fs, forces);
+      cross3(nx, fs, torquesi);
+      scale3(-1, torquesi);
+      copy3(torquesi, torquesj);
+      scale3(radi - 0.5 * delta, torquesi);
+      scale3(radj - 0.5 * delta, torquesj);
+
+      if (fm.rolling || fm.twisting) {
+        double relrot[3];
+        sub3(omega[i], omega[j], relrot);
+        if (fm.rolling) {
+          // rolling velocity, eq. 31 of Wang et al, Particuology 23, 49 (2015)
+          double vrl[3], fr[3], torroll[3];
+          vrl[0] = reff * (relrot[1] * nx[2] - relrot[2] * nx[1]);
+          vrl[1] = reff * (relrot[2] * nx[0] - relrot[0] * nx[2]);
+          vrl[2] = reff * (relrot[0] * nx[1] - relrot[1] * nx[0]);
+          MK::rolling_force(&history[hist_rolling], nx, vrl, dt,
+                            fm.theta_crit * (fm.roll_radius_factor * reff), nf.adhesive / reff,
+                            history_update, fr);
+          cross3(nx, fr, torroll);
+          scale3(reff, torroll);
+          add3(torquesi, torroll, torquesi);
+          sub3(torquesj, torroll, torquesj);
+        }
+        if (fm.twisting) {
+          // omega_T (eq. 29 of Marshall 2009)
+          const double magtwist = dot3(relrot, nx);
+          const double moment = MK::twisting_moment(history[hist_twisting], magtwist, dt, nf.a,
+                                                    fm.k_t, damp_prefactor, fm.mu * fncrit,
+                                                    history_update);
+          double tortwist[3];
+          scale3(moment, nx, tortwist);
+          add3(torquesi, tortwist, torquesi);
+          sub3(torquesj, tortwist, torquesj);
+        }
+      }
+    } else {
+      // PairGranular's sub-model path for this pair
+      model->xi = x[i];
+      model->xj = x[j];
+      model->radi = radius[i];
+      model->radj = radius[j];
+      model->i = i;
+      model->j = j;
+      model->itype = itype;
+      model->jtype = jtype;
+      if (use_history) model->touch = touch[jj];
+      if (!model->check_contact()) {
+        if (use_history) {
+          touch[jj] = 0;
+          for (int k = 0; k < size_hist; k++) history[k] = 0.0;
+        }
+        continue;
+      }
+      if (use_history) touch[jj] = 1;
+
+      const double mi = rmass[i];
+      const double mj = rmass[j];
+      double meff = mi * mj / (mi + mj);
+      if (mask[i] & freeze_group_bit) meff = mj;
+      if (mask[j] & freeze_group_bit) meff = mi;
+      if (asleep) sleeper_mass(asleep[i], asleep[j], mi, mj, meff);
+      model->meff = meff;
+      model->vi = v[i];
+      model->vj = v[j];
+      model->omegai = omega[i];
+      model->omegaj = omega[j];
+      model->history = history;
+      model->calculate_forces();
+      copy3(model->forces, forces);
+      copy3(model->torquesi, torquesi);
+      copy3(model->torquesj, torquesj);
+      copy3(model->dx, dx);
+    }
+
+    // apply forces & torques
+    contacts++;
+    scale3(factor_lj, forces);
+    add3(f[i], forces, f[i]);
+    scale3(factor_lj, torquesi);
+    add3(torque[i], torquesi, torque[i]);
+    if (newton_pair || j < nlocal) {
+      sub3(f[j], forces, f[j]);
+      scale3(factor_lj, torquesj);
+      add3(torque[j], torquesj, torque[j]);
+    }
+    if (evflag)
+      ev_tally_xyz(i, j, nlocal, newton_pair, 0.0, 0.0, forces[0], forces[1], forces[2], dx[0],
+                   dx[1], dx[2]);
+    if (asleep) {
+      ncontact[i] += 1.0;
+      if (newton_pair || j < nlocal) ncontact[j] += 1.0;
+      if (asleep[i] != 0.0) add3(push[i], forces, push[i]);
+      if (asleep[j] != 0.0 && (newton_pair || j < nlocal)) sub3(push[j], forces, push[j]);
     }
   }
   ncontacts = contacts;

@@ -84,6 +84,21 @@ class PairGranularOpt : public PairGranular {
     if (sleep_j != 0.0) meff = mi;
   }
   void update_active(const double *asleep);
+
+  // R_eff and the JKR scales of the pair's radii (recomputed only when they change)
+  static void use_radii(FusedMarshall &fm, double radi, double radj)
+  {
+    if (radi == fm.radi && radj == fm.radj) return;
+    fm.radi = radi;
+    fm.radj = radj;
+    fm.reff = radi * radj / (radi + radj);
+    MarshallKernels::use_jkr_scales(fm.scales, fm.reff, fm.gamma, fm.emix);
+  }
+
+  // compute()'s two passes: the interacting pairs (atom, index in its neighbor list) and the
+  // scaled overlaps and JKR roots of the adhesive fused ones, in pair order
+  std::vector<int> contact_i, contact_jj;
+  std::vector<double> jkr_overlap, jkr_root;
 };
 
 }    // namespace LAMMPS_NS

@@ -116,6 +116,35 @@ TEST(JKRMarshall, ScaledRootAgreesWithBisection)
   EXPECT_NEAR(LAMMPS_NS::JKRScaled::force_over_fc(std::cbrt(6.0)), 0.0, 1e-15);
 }
 
+// 1b'. the batched root (JKRScaled::roots, the pair style's call) on each SIMD path (0 generic,
+// 1 AVX2, 2 AVX-512; one this CPU lacks runs the generic path) gives root()'s double bit for bit:
+// the pair style's forces, and the runs, must not depend on the path. Covered: the 1b range,
+// separation and below (-1, -2, NaN: s = 1), both sides of the table's end (Delta = 255) and the
+// asymptote, and every count 0-19 at every start offset 0-3 (vector remainders, unaligned data).
+TEST(JKRMarshall, BatchedRootsAreTheScalarRoot)
+{
+  using LAMMPS_NS::JKRScaled::root;
+  using LAMMPS_NS::JKRScaled::roots;
+  std::vector<double> Delta{-2.0, -1.0, std::nan(""), -1.0 + 1e-300, 0.0, 1.0, 253.9, 254.0,
+                            254.99999999999997, 255.0, 255.00000000000003, 256.0, 1e5};
+  for (int k = 0; k <= 20000; ++k) Delta.push_back(-1.0 + std::pow(10.0, -12.0 + 17.0 * k / 20000.0));
+  std::vector<double> expect(Delta.size());
+  for (std::size_t k = 0; k < Delta.size(); ++k) expect[k] = root(Delta[k]);
+  for (int path = 0; path <= 2; ++path) {
+    std::vector<double> s(Delta.size(), -7.0);
+    roots(Delta.size(), Delta.data(), s.data(), static_cast<gcfmm::SimdPath>(path));
+    for (std::size_t k = 0; k < Delta.size(); ++k)
+      ASSERT_EQ(s[k], expect[k]) << "path " << path << ", Delta = " << Delta[k];
+    for (std::size_t start = 0; start < 4; ++start)
+      for (std::size_t n = 0; n < 20; ++n) {
+        std::vector<double> part(n + 1, -7.0);
+        roots(n, &Delta[start], part.data(), static_cast<gcfmm::SimdPath>(path));
+        for (std::size_t k = 0; k < n; ++k) ASSERT_EQ(part[k], expect[start + k]);
+        ASSERT_EQ(part[n], -7.0);    // nothing written past n
+      }
+  }
+}
+
 // 1c. the pair force along the stable branch, from separation to ~150 delta_C (an overlap of
 // 0.6 r_p here; the root's asymptotic branch beyond Delta = 255 is covered by 1b), against the
 // test's own closed forms in a-hat. The overlap is set through positions: 2 r_p - delta is rounded to ~4e-22 m, i.e.

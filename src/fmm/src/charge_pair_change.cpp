@@ -9,7 +9,7 @@
 #include <cmath>
 
 #include "gcfmm/dipole_kernels.hpp"
-#include "simd_paths.hpp"
+#include "gcfmm/simd_paths.hpp"
 
 namespace gcfmm {
 

@@ -8,7 +8,7 @@
 #include "gcfmm/expansions.hpp"
 
 #include "gcfmm/options.hpp"
-#include "simd_paths.hpp"
+#include "gcfmm/simd_paths.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "gcfmm/dipole_kernels.hpp"
-#include "simd_paths.hpp"
+#include "gcfmm/simd_paths.hpp"
 
 #if GCFMM_X86_DISPATCH
 #include <immintrin.h>

@@ -5,7 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "simd_paths.hpp"
+#include "gcfmm/simd_paths.hpp"
 
 namespace gcfmm {
 

@@ -1,5 +1,6 @@
 // GRANULAR-CHARGED FMM core library (gcfmm): macros that compile one kernel body for each
-// instruction-set path of include/gcfmm/simd.hpp (private header of src/*.cpp).
+// instruction-set path of gcfmm/simd.hpp (used by src/*.cpp and by the package's batched
+// JKR root, src/GRANULAR-CHARGED/jkr_scaled.cpp).
 #ifndef GCFMM_SIMD_PATHS_HPP
 #define GCFMM_SIMD_PATHS_HPP
 
