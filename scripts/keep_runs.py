@@ -38,6 +38,12 @@ from granular_charged import measures  # noqa: E402
 from granular_charged.runner import read_result  # noqa: E402
 
 PLAIN = ("result.json", "measures.json")
+
+
+def gzip_copy(src: Path, dst: Path):
+    """src compressed into dst (level 9)."""
+    with open(src, "rb") as fi, gzip.open(dst, "wb", 9) as fo:
+        shutil.copyfileobj(fi, fo)
 COMPRESSED = ("final.dump", "forces.dump")
 
 
@@ -70,8 +76,7 @@ def keep(src: Path, dst: Path, images: bool = False) -> int:
                 shutil.copy2(run / name, tmp / name)
         for name in COMPRESSED:
             if (run / name).exists():
-                with open(run / name, "rb") as fi, gzip.open(tmp / f"{name}.gz", "wb", 9) as fo:
-                    shutil.copyfileobj(fi, fo)
+                gzip_copy(run / name, tmp / f"{name}.gz")
         approach = measures.tracer_approach(run, res)
         if approach is not None:
             # the approach up to its first contact, and 100 samples after it (measures, figures)
@@ -90,7 +95,7 @@ POINT_FILES = ("checkpoint.vars", "pieces.json", "tracer.dump")
 def keep_points(src: Path, dst: Path) -> int:
     """The latest restart point of each unfinished run of src into dst/<run>/ (see --points)."""
     import json
-    from granular_charged.runner import CHECKPOINT_VARS, restart_point
+    from granular_charged.runner import CHECKPOINT_VARS, close_interrupted_pieces, restart_point
     kept = 0
     for run in sorted(p for p in src.iterdir() if p.is_dir()):
         target = dst / run.name
@@ -112,8 +117,7 @@ def keep_points(src: Path, dst: Path) -> int:
             vars_text = (run / CHECKPOINT_VARS).read_text()
             mtime = (run / CHECKPOINT_VARS).stat().st_mtime
             restart = run / f"checkpoint-{point['k']}.restart"
-            with open(restart, "rb") as fi, gzip.open(tmp / f"{restart.name}.gz", "wb", 9) as fo:
-                shutil.copyfileobj(fi, fo)
+            gzip_copy(restart, tmp / f"{restart.name}.gz")
         except FileNotFoundError:
             shutil.rmtree(tmp)
             continue
@@ -123,14 +127,10 @@ def keep_points(src: Path, dst: Path) -> int:
         (tmp / CHECKPOINT_VARS).write_text(vars_text)
         for name in POINT_FILES[2:]:
             if (run / name).exists():
-                with open(run / name, "rb") as fi, gzip.open(tmp / f"{name}.gz", "wb", 9) as fo:
-                    shutil.copyfileobj(fi, fo)
+                gzip_copy(run / name, tmp / f"{name}.gz")
         if (run / "pieces.json").exists():
             pieces = json.loads((run / "pieces.json").read_text())
-            for pc in pieces:
-                if "wall_s" not in pc:
-                    pc["interrupted"] = True
-                    pc["wall_s"] = pc["cpu_s"] = max(0.0, mtime - pc["start"])
+            close_interrupted_pieces(pieces, mtime)
             (tmp / "pieces.json").write_text(json.dumps(pieces, indent=1) + "\n")
         shutil.rmtree(target, ignore_errors=True)
         tmp.rename(target)
@@ -183,8 +183,7 @@ def keep_table2(src: Path, dst: Path) -> int:
         shutil.copy2(run / "result.json", tmp / "result.json")
         for name in TABLE2_DUMPS:
             if (run / name).exists():
-                with open(run / name, "rb") as fi, gzip.open(tmp / f"{name}.gz", "wb", 9) as fo:
-                    shutil.copyfileobj(fi, fo)
+                gzip_copy(run / name, tmp / f"{name}.gz")
         tmp.rename(dst / run.name)
         kept += 1
     return kept

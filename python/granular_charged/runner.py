@@ -156,6 +156,15 @@ def restart_point(workdir: Path, suffix: str = "") -> dict | None:
     return point if (workdir / f"checkpoint-{point['k']}.restart{suffix}").exists() else None
 
 
+def close_interrupted_pieces(pieces: list[dict], kept_until: float):
+    """A piece without times was interrupted: it counts up to its last restart point (written
+    at kept_until, a time.time()), as wall and CPU time alike (its later work is done again)."""
+    for pc in pieces:
+        if "wall_s" not in pc:
+            pc["interrupted"] = True
+            pc["wall_s"] = pc["cpu_s"] = max(0.0, kept_until - pc["start"])
+
+
 def trim_dump(path: Path, before_step: int):
     """Keep the snapshots of a LAMMPS text dump from before a step: a run continued from a
     restart point at that step writes the later ones again."""
@@ -313,11 +322,7 @@ class Runner:
         if point is not None:
             with contextlib.suppress(OSError, ValueError):
                 pieces = json.loads((wd / PIECES).read_text())
-            kept_until = (wd / CHECKPOINT_VARS).stat().st_mtime
-            for pc in pieces:
-                if "wall_s" not in pc:
-                    pc["interrupted"] = True
-                    pc["wall_s"] = pc["cpu_s"] = max(0.0, kept_until - pc["start"])
+            close_interrupted_pieces(pieces, (wd / CHECKPOINT_VARS).stat().st_mtime)
             variables["resume"] = "yes"
             for name in FOLLOWING_DUMPS:
                 trim_dump(wd / name, point["step"])
