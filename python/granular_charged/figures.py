@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import logging
 import math
+import multiprocessing
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from types import MappingProxyType
 
@@ -595,37 +597,53 @@ def conventions(results, out: Path):
 # ---- everything -----------------------------------------------------------------------------
 
 def all_figures(results, out: Path, table2_rows: list[dict] | None = None,
-                table2_dir: Path | None = None) -> list[Path]:
-    """Every figure the given runs allow; returns the PNG paths written."""
+                table2_dir: Path | None = None, jobs: int = 1) -> list[Path]:
+    """Every figure the given runs allow; returns the PNG paths written. jobs > 1: drawn by
+    that many processes (each figure is independent of the others)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     results = [r for r in results if r.get("complete")]
-    paths: list[Path | None] = []
     if not results:
         log.warning("figures: no finished runs")
         return []
+    tasks = figure_tasks(results, out, table2_rows)
+    if jobs > 1 and len(tasks) > 1:
+        # fork: the workers start at once with this process's modules (no re-import)
+        with ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork")) as ex:
+            drawn = list(ex.map(_draw, tasks))
+    else:
+        drawn = [_draw(t) for t in tasks]
+    paths = [q for d in drawn for q in (d if isinstance(d, (tuple, list)) else (d,))]
+    return [q for q in paths if q is not None]
+
+
+def _draw(task):
+    fn, args = task
+    return fn(*args)
+
+
+def figure_tasks(results, out: Path, table2_rows: list[dict] | None) -> list[tuple]:
+    """The figures of all_figures as (function, arguments), in the order of their paths."""
+    tasks = []
     ok = _ok(results)
     for r, name in zip(ok, packing_image_names(ok)):
-        paths.append(packing_image(r, out, name))
-    paths.append(packings_panel(results, out))
-    p = phi_vs_q(results, out)
-    paths += list(p) if isinstance(p, tuple) else [p]
-    paths += [rdf(results, out), fZ(results, out), tracer_energy(results, out),
-              conventions(results, out)]
-    paths += list(vs_adstar(results, out))
+        tasks.append((packing_image, (r, out, name)))
+    tasks += [(packings_panel, (results, out)), (phi_vs_q, (results, out)),
+              (rdf, (results, out)), (fZ, (results, out)), (tracer_energy, (results, out)),
+              (conventions, (results, out)), (vs_adstar, (results, out))]
     if ok:
         key, byq = _biggest_series(ok)
         qs = list(byq)
         picks = [byq[qs[0]][0]] + ([byq[qs[-1]][0]] if len(qs) > 1 else [])
         params = picks[0]["params"]
-        paths.append(force_network(
+        tasks.append((force_network, (
             [(f"deposited with q = {r['params']['q']:g} e0", Path(r["dir"]) / "final.dump",
               Path(r["dir"]) / "forces.dump") for r in picks], params, out,
-            "force_network_deposition.png"))
-        paths.append(force_pdf([(f"deposited with q = {q:g} e0", Path(r["dir"]) / "forces.dump")
-                                for q in qs for r in byq[q][:1]], params, out))
+            "force_network_deposition.png")))
+        tasks.append((force_pdf, ([(f"deposited with q = {q:g} e0", Path(r["dir"]) / "forces.dump")
+                                   for q in qs for r in byq[q][:1]], params, out)))
     if table2_rows:
-        paths.append(table2(table2_rows, out))
+        tasks.append((table2, (table2_rows, out)))
         # the paper's Figs. 6 and 7 proper: the Table 2 packing before and after charging (of
         # the first seed when several packings were checked)
         first = min((r.get("params") or {}).get("seed", 0) for r in table2_rows)
@@ -633,11 +651,12 @@ def all_figures(results, out: Path, table2_rows: list[dict] | None = None,
                    key=lambda r: r["q"])
         d = Path(last["dir"])
         params = last["params"]
-        paths.append(force_network(
+        tasks.append((force_network, (
             [("neutral packing (formed with q = 0)", d / "before.dump", d / "forces_before.dump"),
              (f"after charging to q = {last['q']:g} e0 and relaxing", d / "after.dump",
-              d / "forces_after.dump")], params, out, "force_network.png"))
-        paths.append(force_pdf([("neutral packing", d / "forces_before.dump"),
-                                (f"charged after formation, q = {last['q']:g} e0",
-                                 d / "forces_after.dump")], params, out, "force_pdf_table2.png"))
-    return [p for p in paths if p is not None]
+              d / "forces_after.dump")], params, out, "force_network.png")))
+        tasks.append((force_pdf, ([("neutral packing", d / "forces_before.dump"),
+                                   (f"charged after formation, q = {last['q']:g} e0",
+                                    d / "forces_after.dump")], params, out,
+                                  "force_pdf_table2.png")))
+    return tasks

@@ -93,10 +93,10 @@ class Reproduction(Study):
     def table2_charges(self) -> tuple:
         return (0.0, 400.0) if self.quick else tuple(self.table2_qs)
 
-    def table2_packings(self, formed: list[dict]) -> list[dict]:
+    def table2_seeds(self) -> tuple:
         # paper size: every seed's packing (~1.5 CPU minutes per charge, beside hours of
         # depositions), so the Table 2 row is a mean over seeds as the others are
-        return formed if self.size_name == "paper" else formed[:1]
+        return tuple(self.seeds) if self.size_name == "paper" else tuple(self.seeds[:1])
 
     def analyse(self, runs, summary, out, results) -> dict:
         if not results:      # --finished-only before the first run

@@ -21,6 +21,7 @@ import resource
 import shutil
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -195,6 +196,24 @@ class Runner:
         self.timeout = timeout
         self.render = render
         self.checkpoint = checkpoint
+        self._slots = contextlib.nullcontext()
+        self._stopped = False
+
+    @contextlib.contextmanager
+    def at_most(self, jobs: int):
+        """Within: at most `jobs` LAMMPS runs of this runner at a time, whichever threads start
+        them, so that a study's depositions and its Table 2 runs share the cores (a run's wall
+        time counts from when it has its slot). Left by an exception (Ctrl-C): the runs still
+        waiting for a slot do not start (RunError)."""
+        self._slots = threading.BoundedSemaphore(max(1, jobs))
+        self._stopped = False
+        try:
+            yield self
+        except BaseException:
+            self._stopped = True
+            raise
+        finally:
+            self._slots = contextlib.nullcontext()
 
     # ---- one deck -------------------------------------------------------------------------
     def run_deck(self, deck: str, workdir: Path, variables: dict, kind: str = "none",
@@ -215,14 +234,17 @@ class Runner:
                     raise RunError("mpirun not found (needed for --np > 1)")
                 cmd = [mpirun, "-np", str(self.np_ranks), "--oversubscribe"] + cmd
             log.debug("run: %s", " ".join(cmd))
-            t0 = time.monotonic()
-            ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
             env = self.build.child_env()
             env[PARENT_ENV] = str(os.getpid())    # the child exits when this process dies
-            r = subprocess.run(cmd, env=env, capture_output=True, text=True,
-                               timeout=self.timeout)
-            wall = time.monotonic() - t0
-            ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            with self._slots:
+                if self._stopped:
+                    raise RunError(f"{workdir}: not started (the study was stopped)")
+                t0 = time.monotonic()
+                ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+                r = subprocess.run(cmd, env=env, capture_output=True, text=True,
+                                   timeout=self.timeout)
+                wall = time.monotonic() - t0
+                ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         res_file = workdir / "lammps.json"
         if r.returncode != 0 or not res_file.exists():
             logf = workdir / "log.lammps"

@@ -1,7 +1,8 @@
 """One runner for the studies of the command line (``demo`` and ``reproduce``): the depositions
 of a list of cases and seeds (a resumable sweep), runs.csv and summary.csv, the Table 2 check on
-the first neutral packing of the Fig. 2 case (or on each, :meth:`Study.table2_packings`), and
-the figures, all in one folder.
+the first neutral packing of the Fig. 2 case (or on each, :meth:`Study.table2_seeds`), and
+the figures, all in one folder. The Table 2 runs start as soon as their packing is there, beside
+the remaining depositions (:meth:`Runner.at_most` keeps the LAMMPS runs to ``jobs`` at a time).
 
 A study says which runs it wants (:meth:`Study.params`), which particle to follow
 (:meth:`Study.tracer`), the charges of its Table 2 check (:meth:`Study.table2_charges`) and what
@@ -12,6 +13,7 @@ from __future__ import annotations
 
 import logging
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -66,10 +68,9 @@ class Study:
     def table2_charges(self) -> tuple:
         return tuple(self.table2_qs)
 
-    def table2_packings(self, formed: list[dict]) -> list[dict]:
-        """The neutral Fig. 2 packings (sorted by seed) that the Table 2 check charges: the
-        first."""
-        return formed[:1]
+    def table2_seeds(self) -> tuple:
+        """The seeds whose neutral Fig. 2 packings the Table 2 check charges: the first."""
+        return tuple(self.seeds[:1])
 
     def analyse(self, runs, summary, out: Path, results: list[dict]) -> dict:
         """The study's own analyses of the runs (written under out); entries of run()'s result.
@@ -86,42 +87,58 @@ class Study:
             log.warning("fix coul/fmm is NOT in this build: only the neutral cases run; the "
                         "charged cases need fix coul/fmm (they are not faked)")
         params = self.params(have_fmm)
+        t2 = []
         if self.finished_only:
             found = [runner.finished(p, out / "runs") for p in params]
             results = [dict(r, dir=str(runner.workdir(p, out / "runs")))
                        for p, r in zip(params, found) if r is not None]
             log.info("%d of the study's %d runs are finished in %s (--finished-only: nothing "
                      "is run)", len(results), len(params), out / "runs")
+            for d in table2_folders(out):
+                t2 += load_table2(d)
         else:
-            results = Sweep(runner, out / "runs", jobs=self.jobs, progress=self.progress).run(
-                params, tracer=self.tracer)
+            results, t2 = self._run_all(runner, params, out, have_fmm)
         runs = tables.runs_frame(results)
         summ = tables.summary(runs)
         runs.drop(columns=["dir"]).to_csv(out / "runs.csv", index=False)
         summ.to_csv(out / "summary.csv", index=False)
         res = {"out": out, "results": results, "runs": runs, "summary": summ,
                "have_fmm": have_fmm, **self.analyse(runs, summ, out, results)}
-        t2 = []
-        formed = sorted((r for r in results
-                         if all(r["params"][k] == v for k, v in FIG2_CASE.items())),
-                        key=lambda r: r["params"]["seed"])
-        qs = self.table2_charges()
-        if self.finished_only:
-            for d in table2_folders(out):
-                t2 += load_table2(d)
-        elif formed and have_fmm and qs:
-            # the Table 2 runs take the formed run's settings (run_table2)
-            for k, r in enumerate(self.table2_packings(formed)):
-                try:
-                    t2 += run_table2(runner, Path(r["dir"]), qs,
-                                     table2_folder(out, None if k == 0 else r["params"]["seed"]),
-                                     jobs=self.jobs)
-                except RunError as e:
-                    log.error("Table 2 check FAILED: %s", e)
         res["table2"] = tables.table2_frame(t2) if t2 else None
         res["table2_rows"] = t2
-        res["figures"] = figures.all_figures(results, out / "figures", t2)
+        res["figures"] = figures.all_figures(results, out / "figures", t2, jobs=self.jobs)
         res["wall_s"] = time.monotonic() - t0
         res["complete"] = len(results) == len(params)
         res["missing"] = len(params) - len(results)
         return res
+
+    def _run_all(self, runner: Runner, params, out: Path, have_fmm: bool):
+        """The depositions, and the Table 2 check of each chosen packing as soon as that packing
+        is there (beside the remaining depositions: at most self.jobs LAMMPS runs at a time in
+        all); returns the deposition results and the Table 2 rows (packings by seed)."""
+        qs = self.table2_charges()
+        seeds = self.table2_seeds() if have_fmm and qs else ()
+        checks = {}
+        # the pool last out: a Ctrl-C leaves at_most first, so that a waiting check does not start
+        with ThreadPoolExecutor(1) as pool, runner.at_most(self.jobs):
+            def start_check(p, r):
+                if p.seed in seeds and all(getattr(p, k) == v for k, v in FIG2_CASE.items()) \
+                        and p.seed not in checks:
+                    folder = table2_folder(out, None if p.seed == seeds[0] else p.seed)
+                    # the Table 2 runs take the formed run's settings (run_table2)
+                    checks[p.seed] = pool.submit(run_table2, runner, Path(r["dir"]), qs, folder,
+                                                 jobs=self.jobs)
+            results = Sweep(runner, out / "runs", jobs=self.jobs, progress=self.progress).run(
+                params, tracer=self.tracer, on_result=start_check)
+            t2 = []
+            for seed in sorted(checks):
+                try:
+                    t2 += checks[seed].result()
+                except RunError as e:
+                    log.error("Table 2 check FAILED: %s", e)
+        for seed in seeds:
+            if seed not in checks:
+                log.error("Table 2 check not run for seed %d: its neutral packing of the paper's "
+                          "Fig. 2 case is missing (failed, or not in this study)", seed)
+        return results, t2
+

@@ -61,10 +61,12 @@ class Sweep:
         self.keep_going = keep_going
         self.progress = progress
 
-    def run(self, params: list[DepositionParams], tracer=0) -> list[dict]:
+    def run(self, params: list[DepositionParams], tracer=0, on_result=None) -> list[dict]:
         """Run every parameter set not finished before; return all results (finished before
         and new) in the order of params, failed runs left out (logged). ``tracer``: particle id
-        to follow, or a function of the DepositionParams giving it."""
+        to follow, or a function of the DepositionParams giving it. ``on_result(p, result)``:
+        called in this thread for each result as soon as it is there (finished before: first)."""
+        on_result = on_result or (lambda p, r: None)
         for p in params:          # every run checked before the first starts
             self.runner.check(p, tracer(p) if callable(tracer) else tracer)
         self.out.mkdir(parents=True, exist_ok=True)
@@ -76,6 +78,7 @@ class Sweep:
                 r["skipped"] = True
                 r["dir"] = str(self.runner.workdir(p, self.out))
                 results[k] = r
+                on_result(p, r)
             else:
                 todo.append((k, p))
         n = len(params)
@@ -116,6 +119,7 @@ class Sweep:
                         raise err
                     return
                 results[k] = r
+                on_result(p, r)
                 log.info("%s %s  %6.1f s  phi = %s  <Z> = %s  lost %d  flying %d", eta(),
                          p.key(), r["wall_s"], fmt(r["phi"], ".4f"), fmt(r["Z"], ".3f"),
                          r["lost"], r["flying"])

@@ -49,10 +49,9 @@ def test_finished_only_runs_nothing(cli, tmp_path):
 def test_paper_size_checks_table2_on_every_seeds_packing(tmp_path):
     from granular_charged.demo import Demo
     from granular_charged.study import table2_folder, table2_folders
-    formed = [{"params": {"seed": s}} for s in (1, 2, 3)]
-    assert Reproduction(out=".", size_name="paper").table2_packings(formed) == formed
-    assert Reproduction(out=".", size_name="demo").table2_packings(formed) == formed[:1]
-    assert Demo(out=".").table2_packings(formed) == formed[:1]
+    assert Reproduction(out=".", size_name="paper").table2_seeds() == (1, 2, 3)
+    assert Reproduction(out=".", size_name="demo").table2_seeds() == (1,)
+    assert Demo(out=".", seeds=(4, 5)).table2_seeds() == (4,)
     # the first packing's folder is the one a single check always used (kept data stay valid)
     assert table2_folder(tmp_path, None) == tmp_path / "table2"
     for name in ("table2-s3", "table2-s10", "table2", "table2-s2", "table2-sx"):
