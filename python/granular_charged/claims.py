@@ -69,6 +69,14 @@ def _verdict(z: float, what_if_positive: str, what_if_negative: str) -> str:
     return f"{what_if_positive if z > 0 else what_if_negative} ({z:+.1f} standard errors)"
 
 
+def _tracers(row) -> str:
+    """E_k/E_k0 of a case's tracers: mean +- sd over the seeds that followed one, or the one."""
+    n = int(row["Ek_before_contact_n"])
+    if n > 1:
+        return f"{_pm(row, 'Ek_before_contact')} ({n} tracers)"
+    return f"{row['Ek_before_contact']:.2f} (one tracer)"
+
+
 def _label(key) -> str:
     return f"r_p = {key[0]:g} um, U_0 = {key[1]:g} m/s" + (
         f", gamma = {key[2]:g} mJ/m^2" if key[2] != 10.0 else "")
@@ -130,10 +138,12 @@ def claim_lines(runs: pd.DataFrame) -> list[str]:
                      f"({_verdict(zm, 'towards compression', 'towards tension')})")
         ek = s[np.isfinite(s["Ek_before_contact"])]
         if len(ek):
-            lines.append(f"{_label(key)}: incident particle's E_k/E_k0 before its first contact "
-                         "(one tracer per case): " + ", ".join(
-                             f"q = {q:g}: {v:.2f}" for q, v in zip(ek["q"], ek["Ek_before_contact"]))
-                         + " (paper, Fig. 8: falls with q)")
+            line = (f"{_label(key)}: incident particle's E_k/E_k0 before its first contact: "
+                    + ", ".join(f"q = {r['q']:g}: {_tracers(r)}" for _, r in ek.iterrows()))
+            if ek.iloc[0]["q"] == 0 and len(ek) > 1:
+                _, z = _difference(ek.iloc[0], ek.iloc[-1], "Ek_before_contact")
+                line += f"; 0 -> {ek.iloc[-1]['q']:g} e0: " + _verdict(z, "higher", "lower")
+            lines.append(line + " (paper, Fig. 8: falls with q)")
 
     # f(Z) vs r_p and U_0 among the neutral cases (Fig. 5: smaller r_p or U_0 move it left)
     ref = neutral[(neutral[SERIES] == pd.Series(dict(zip(SERIES, FIG2_SERIES)))).all(axis=1)]

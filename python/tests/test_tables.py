@@ -148,3 +148,24 @@ def test_packing_images_of_several_series_get_their_own_names():
     two = [_params(), {"params": dict(_params()["params"], rp=1e-6)}]
     names = packing_image_names(two)
     assert names == ["packing_rp2um_U1_g10mJ_q0_s1.png", "packing_rp1um_U1_g10mJ_q0_s1.png"]
+
+
+def test_tracer_energy_claim_is_a_mean_over_the_seeds_that_followed_one():
+    """The E_k/E_k0 line: mean +- sd and a verdict where several seeds followed a tracer, the
+    single value (and no verdict) where one did."""
+    from granular_charged import claims
+    rows = []
+    for q, eks in ((0.0, (1.01, 1.00, 1.02)), (260.0, (0.80, np.nan, np.nan)),
+                   (400.0, (0.50, 0.55, 0.45))):
+        for seed, ek in enumerate(eks, 1):
+            row = {"rp_um": 2.0, "U0": 1.0, "gamma_mJ": 10.0, "q": q, "seed": seed, "Ad": 2.0,
+                   "Estar": 0.0, "Adstar": 2.0, "phi": 0.4, "Z": 3.9}
+            row.update({c: 0.1 for c in claims.MEASURE_COLUMNS})
+            row["Ek_before_contact"] = ek
+            rows.append(row)
+    line = next(ln for ln in claims.claim_lines(pd.DataFrame(rows)) if "E_k/E_k0" in ln)
+    assert "q = 0: 1.010 +- 0.010 (3 tracers)" in line
+    assert "q = 260: 0.80 (one tracer)" in line
+    assert "q = 400: 0.500 +- 0.050 (3 tracers)" in line
+    # 0.51 lower, standard error sqrt(0.01^2 + 0.05^2) / sqrt 3 = 0.029: -17 standard errors
+    assert "0 -> 400 e0: lower (-17.3 standard errors)" in line
