@@ -159,7 +159,8 @@ def test_tracer_energy_claim_is_a_mean_over_the_seeds_that_followed_one():
                    (400.0, (0.50, 0.55, 0.45))):
         for seed, ek in enumerate(eks, 1):
             row = {"rp_um": 2.0, "U0": 1.0, "gamma_mJ": 10.0, "q": q, "seed": seed, "Ad": 2.0,
-                   "Estar": 0.0, "Adstar": 2.0, "phi": 0.4, "Z": 3.9}
+                   "Estar": 0.0, "Adstar": 2.0, "phi": 0.42 - 1e-4 * q + 1e-3 * seed,
+                   "Z": 3.9 - 1e-3 * q + 0.01 * seed}
             row.update({c: 0.1 for c in claims.MEASURE_COLUMNS})
             row["Ek_before_contact"] = ek
             rows.append(row)
