@@ -466,32 +466,61 @@ def force_pdf(panels: list[tuple[str, Path]], params: dict, out: Path, name="for
 
 
 def tracer_energy(results, out: Path):
-    """Kinetic energy of an incident particle vs its gap to the nearest earlier particle (Fig. 8).
-    The bed is taken from the final configuration (particles with smaller id, which arrived
-    before the tracer: hit-and-stick keeps them where they were when the tracer came)."""
-    runs = [r for r in results if r.get("tracer") and packing.dump_exists(Path(r["dir"]) / "tracer.dump")]
+    """The incident particle's kinetic energy (Fig. 8). Left: E_k/E_k0 against its gap to the
+    nearest earlier particle or the floor, one tracer per charge (the lowest seed's) of the
+    series with the most charges, the paper's figure. Right: E_k/E_k0 just before the first
+    contact against q for every series, mean +- sd over the seeds that followed a tracer. The
+    bed is taken from the final configuration (particles with smaller id, which arrived before
+    the tracer: hit-and-stick keeps them where they were when the tracer came)."""
+    runs = [r for r in _ok(results)
+            if r.get("tracer") and packing.dump_exists(Path(r["dir"]) / "tracer.dump")]
     if not runs:
         log.warning("figure tracer_energy: no run with a tracer particle")
         return None
-    fig = new_figure(5.2, 4.0)
-    ax = fig.add_subplot(111)
+    fig = new_figure(10.0, 4.2)
+    ax, axq = fig.add_subplot(121), fig.add_subplot(122)
+    key, byq = _biggest_series(runs)
     frames = []
-    for r in sorted(runs, key=lambda r: r["params"]["q"]):
-        p = r["params"]
+    for q, rs in byq.items():
+        r = min(rs, key=lambda r: r["params"]["seed"])
         t = measures.tracer_approach(Path(r["dir"]), r)
         if t is None:
             continue
         gaps, eks, k = t
-        line, = ax.plot(gaps[: k + 1], eks[: k + 1], label=f"q = {p['q']:g} e0 (particle "
-                        f"{r['tracer']}): E_k/E_k0 = {eks[k - 1]:.3f} before the first contact")
+        line, = ax.plot(gaps[: k + 1], eks[: k + 1], label=f"q = {q:g} e0: E_k/E_k0 = "
+                        f"{eks[k - 1]:.3f} before the first contact")
         ax.plot(gaps[k - 1], eks[k - 1], "o", color=line.get_color())
-        frames.append(pd.DataFrame({"q": p["q"], "gap_over_rp": gaps, "Ek_over_Ek0": eks}))
+        frames.append(pd.DataFrame({"q": q, "seed": r["params"]["seed"], "gap_over_rp": gaps,
+                                    "Ek_over_Ek0": eks}))
     ax.axvline(0, color="grey", ls="--", lw=0.8)
     ax.set_xscale("symlog", linthresh=0.1)
     ax.set_xlabel("gap to the nearest deposited particle or the floor / r_p")
     ax.set_ylabel("E_k / E_k0")
+    ax.set_title(f"{_series_label(key)}, one tracer per q", fontsize=9)
     ax.legend(fontsize=7)
+    # right: every series, the value before the first contact over the seeds
+    rows = [{"rp_um": r["params"]["rp"] * 1e6, "U0": r["params"]["U0"],
+             "gamma_mJ": r["params"]["gamma"] * 1e3, "q": r["params"]["q"],
+             "seed": r["params"]["seed"],
+             "Ek_before_contact": measures.load(r["dir"], r).get("Ek_before_contact", np.nan)}
+            for r in runs]
+    before = pd.DataFrame(rows).dropna(subset=["Ek_before_contact"])
+    for skey, g in before.groupby(["rp_um", "U0", "gamma_mJ"]):
+        m = g.groupby("q")["Ek_before_contact"].agg(["mean", "std", "count"]).reset_index()
+        axq.errorbar(m["q"], m["mean"], yerr=m["std"].fillna(0.0), marker="o", capsize=3,
+                     label=_series_label(skey) + (f" (up to {m['count'].max()} tracers per q)"
+                                                  if m["count"].max() > 1 else ""))
+    axq.set_xlabel("q / e0")
+    axq.set_ylabel("E_k / E_k0 before the first contact")
+    axq.set_title("mean +- sd over the seeds that followed a tracer", fontsize=9)
+    axq.legend(fontsize=7)
+    before.to_csv(Path(out) / "tracer_energy_before_contact.csv", index=False)
     return save(fig, Path(out) / "tracer_energy.png", pd.concat(frames) if frames else None)
+
+
+def _series_label(key) -> str:
+    rp, u0, gamma = key
+    return f"r_p = {rp:g} um, U_0 = {u0:g} m/s, gamma = {gamma:g} mJ/m^2"
 
 
 def vs_adstar(results, out: Path):
