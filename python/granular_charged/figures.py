@@ -469,7 +469,8 @@ def tracer_energy(results, out: Path):
     """The incident particle's kinetic energy (Fig. 8). Left: E_k/E_k0 against its gap to the
     nearest earlier particle or the floor, one tracer per charge (the lowest seed's) of the
     series with the most charges, the paper's figure. Right: E_k/E_k0 just before the first
-    contact against q for every series, mean +- sd over the seeds that followed a tracer. The
+    contact against q for every series with a charged tracer, mean +- sd over the seeds that
+    followed one (tracer_energy_before_contact.csv has every tracer's value). The
     bed is taken from the final configuration (particles with smaller id, which arrived before
     the tracer: hit-and-stick keeps them where they were when the tracer came)."""
     runs = [r for r in _ok(results)
@@ -477,7 +478,7 @@ def tracer_energy(results, out: Path):
     if not runs:
         log.warning("figure tracer_energy: no run with a tracer particle")
         return None
-    fig = new_figure(10.0, 4.2)
+    fig = new_figure(13.0, 4.2)
     ax, axq = fig.add_subplot(121), fig.add_subplot(122)
     key, byq = _biggest_series(runs)
     frames = []
@@ -506,14 +507,17 @@ def tracer_energy(results, out: Path):
             for r in runs]
     before = pd.DataFrame(rows).dropna(subset=["Ek_before_contact"])
     for skey, g in before.groupby(["rp_um", "U0", "gamma_mJ"]):
+        if not (g["q"] > 0).any():
+            continue                     # a neutral case alone: no trend to draw
         m = g.groupby("q")["Ek_before_contact"].agg(["mean", "std", "count"]).reset_index()
         axq.errorbar(m["q"], m["mean"], yerr=m["std"].fillna(0.0), marker="o", capsize=3,
                      label=_series_label(skey) + (f" (up to {m['count'].max()} tracers per q)"
                                                   if m["count"].max() > 1 else ""))
+    axq.set_xscale("symlog", linthresh=30.0)    # the series' charges span 30-2000 e0
     axq.set_xlabel("q / e0")
     axq.set_ylabel("E_k / E_k0 before the first contact")
     axq.set_title("mean +- sd over the seeds that followed a tracer", fontsize=9)
-    axq.legend(fontsize=7)
+    axq.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0))
     before.to_csv(Path(out) / "tracer_energy_before_contact.csv", index=False)
     return save(fig, Path(out) / "tracer_energy.png", pd.concat(frames) if frames else None)
 
