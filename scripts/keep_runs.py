@@ -38,13 +38,13 @@ from granular_charged import measures  # noqa: E402
 from granular_charged.runner import read_result  # noqa: E402
 
 PLAIN = ("result.json", "measures.json")
+COMPRESSED = ("final.dump", "forces.dump")
 
 
 def gzip_copy(src: Path, dst: Path):
     """src compressed into dst (level 9)."""
     with open(src, "rb") as fi, gzip.open(dst, "wb", 9) as fo:
         shutil.copyfileobj(fi, fo)
-COMPRESSED = ("final.dump", "forces.dump")
 
 
 def tracer_snapshots(text: str, upto: int) -> str:

@@ -497,21 +497,19 @@ def tracer_energy(results, out: Path):
     ax.set_xscale("symlog", linthresh=0.1)
     ax.set_xlabel("gap to the nearest deposited particle or the floor / r_p")
     ax.set_ylabel("E_k / E_k0")
-    ax.set_title(f"{_series_label(key)}, one tracer per q", fontsize=9)
+    ax.set_title(f"{_label(key)}, one tracer per q", fontsize=9)
     ax.legend(fontsize=7)
     # right: every series, the value before the first contact over the seeds
-    rows = [{"rp_um": r["params"]["rp"] * 1e6, "U0": r["params"]["U0"],
-             "gamma_mJ": r["params"]["gamma"] * 1e3, "q": r["params"]["q"],
-             "seed": r["params"]["seed"],
-             "Ek_before_contact": measures.load(r["dir"], r).get("Ek_before_contact", np.nan)}
-            for r in runs]
-    before = pd.DataFrame(rows).dropna(subset=["Ek_before_contact"])
-    for skey, g in before.groupby(["rp_um", "U0", "gamma_mJ"]):
+    before = tables.runs_frame(runs)[[*tables.CASE, "seed"]]
+    before["Ek_before_contact"] = [measures.load(r["dir"], r).get("Ek_before_contact", np.nan)
+                                   for r in runs]
+    before = before.dropna(subset=["Ek_before_contact"])
+    for skey, g in before.groupby(list(tables.CASE[:3])):
         if not (g["q"] > 0).any():
             continue                     # a neutral case alone: no trend to draw
         m = g.groupby("q")["Ek_before_contact"].agg(["mean", "std", "count"]).reset_index()
         axq.errorbar(m["q"], m["mean"], yerr=m["std"].fillna(0.0), marker="o", capsize=3,
-                     label=_series_label(skey) + (f" (up to {m['count'].max()} tracers per q)"
+                     label=_label(skey) + (f" (up to {m['count'].max()} tracers per q)"
                                                   if m["count"].max() > 1 else ""))
     axq.set_xscale("symlog", linthresh=30.0)    # the series' charges span 30-2000 e0
     axq.set_xlabel("q / e0")
@@ -520,11 +518,6 @@ def tracer_energy(results, out: Path):
     axq.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0))
     before.to_csv(Path(out) / "tracer_energy_before_contact.csv", index=False)
     return save(fig, Path(out) / "tracer_energy.png", pd.concat(frames) if frames else None)
-
-
-def _series_label(key) -> str:
-    rp, u0, gamma = key
-    return f"r_p = {rp:g} um, U_0 = {u0:g} m/s, gamma = {gamma:g} mJ/m^2"
 
 
 def vs_adstar(results, out: Path):
