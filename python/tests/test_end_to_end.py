@@ -235,6 +235,19 @@ def test_figure_files(study, name):
         assert len(pd.read_csv(png.with_suffix(".csv"))) > 0
 
 
+def test_tracer_figure_data_are_the_measured_values(study):
+    """tracer_energy's right panel: one row per run with a followed particle, the value of its
+    measures.json (the left panel's CSV: that particle's approach, one per charge)."""
+    before = pd.read_csv(study["out"] / "figures" / "tracer_energy_before_contact.csv")
+    by_q = {r["params"]["q"]: json.loads((Path(r["dir"]) / "measures.json").read_text())
+            for r in results(study)}
+    assert sorted(before["q"]) == sorted(by_q)
+    for q, ek in zip(before["q"], before["Ek_before_contact"]):
+        assert ek == pytest.approx(by_q[q]["Ek_before_contact"], rel=1e-12)
+    approach = pd.read_csv(study["out"] / "figures" / "tracer_energy.csv")
+    assert sorted(approach["q"].unique()) == sorted(by_q)
+
+
 def test_rendered_packing_is_lammps_dump_image_coloured_by_Z(study):
     from granular_charged.paper import Z_COLORS
     for r in results(study):
