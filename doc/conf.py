@@ -61,8 +61,9 @@ def _repository_path(app, env, node, contnode):
     if not source.startswith(_REPO_DIR + os.sep) or not os.path.exists(source):
         return None
     if app.builder.name == "linkcheck":
-        # Sphinx's linkcheck tests a local link as a path below the source folder.
-        uri = os.path.relpath(source, _DOC_DIR).replace(os.sep, "/")
+        # Sphinx's linkcheck tests a local link as a path relative to the page's source.
+        uri = os.path.relpath(source, os.path.join(_DOC_DIR, os.path.dirname(refdoc)))
+        uri = uri.replace(os.sep, "/")
     else:
         page_dir = os.path.join(app.outdir, os.path.dirname(refdoc))
         uri = os.path.relpath(source, page_dir).replace(os.sep, "/")
