@@ -60,6 +60,9 @@ def _repository_path(app, env, node, contnode):
     source = os.path.normpath(os.path.join(_DOC_DIR, os.path.dirname(refdoc), path))
     if not source.startswith(_REPO_DIR + os.sep) or not os.path.exists(source):
         return None
+    docname = os.path.splitext(os.path.relpath(source, _DOC_DIR))[0].replace(os.sep, "/")
+    if docname in env.found_docs:
+        return None  # a page of the manual: an unresolved link to it (bad anchor) must warn
     if app.builder.name == "linkcheck":
         # Sphinx's linkcheck tests a local link as a path relative to the page's source.
         uri = os.path.relpath(source, os.path.join(_DOC_DIR, os.path.dirname(refdoc)))
