@@ -22,9 +22,10 @@ root_doc = "index"
 # to this manual that a reader of the repository sees on its own.
 exclude_patterns = ["data", "figures", "README.md", "_build", "Thumbs.db", ".DS_Store"]
 
-# Markdown: "$...$" maths as in the pages, anchors for "#section" links inside a page
-# and between pages (headings down to level 4).
-myst_enable_extensions = ["dollarmath", "colon_fence"]
+# Markdown: plain CommonMark plus tables; the pages write their equations as text, so no
+# "$...$" maths (a shell variable such as ${zlo} must stay text). Anchors for "#section"
+# links inside a page and between pages (headings down to level 4).
+myst_enable_extensions = []
 myst_heading_anchors = 4
 
 html_theme = "sphinx_rtd_theme"
