@@ -4,8 +4,8 @@
 Scans README.md, doc/ (but not doc/data/, the kept runs and their records), examples/, src/
 and python/ for
   - ISO dates of work (2026-12-03), and month-year dates ("Dec 2026", "3 December 2026");
-  - the words session, sitting, yesterday, and internal issue numbers ("issue 45",
-    "issues 14 and 11", "#45");
+  - the words session, sitting, yesterday, and internal issue numbers or names ("issue 45",
+    "issues 14 and 11", "#45", 'issue "Deposition throughput"');
 and prints file:line: text for each hit (--summary: the count per file). Exit status 1 when there is any hit, 0 otherwise.
 
 What is not a hit: LAMMPS's release names (4Jul2026, 4Feb2025, the version 20260704) name
@@ -30,7 +30,8 @@ PATTERNS = [
     ("date", re.compile(r"\b20\d\d-\d\d-\d\d\b")),
     ("date", re.compile(r"\b(?:%s)\.? +(?:\d{1,2}, +)?20\d\d\b" % MONTHS)),
     ("word", re.compile(r"\b(?:sessions?|sittings?|yesterday)\b", re.I)),
-    ("issue", re.compile(r"\bissues? +\d+|\bissues? +#\d+|(?<![\w&/])#\d{1,3}\b", re.I)),
+    ("issue", re.compile(r"\bissues? +\d+|\bissues? +#\d+|\bissues? +[\"\u201c]|(?<![\w&/])#\d{1,3}\b",
+                         re.I)),
 ]
 # Terms of an API that contain a listed word without being a diary: pytest's fixture scope.
 ALLOWED = [re.compile(r"""scope\s*=\s*["']session["']""")]

@@ -28,6 +28,7 @@ def test_finds_diary(tmp_path):
     assert hits("yesterday's run\n", tmp_path) == ["word"]
     assert hits("fixed in issue 45\n", tmp_path) == ["issue"]
     assert hits("(issues 14 and 11)\n", tmp_path) == ["issue"]
+    assert hits('### Protocol checks (issue "Deposition throughput")\n', tmp_path) == ["issue"]
 
 
 def test_lets_pass(tmp_path):
