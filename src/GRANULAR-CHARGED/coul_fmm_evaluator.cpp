@@ -10,7 +10,6 @@
 #include "coul_fmm_evaluator.h"
 
 #include "coul_fmm_sleepers.h"
-#include "fix_sleep_gran.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -122,7 +121,7 @@ void CoulFMMEvaluator::check_counted_once(Fix *self)
   }
 }
 
-void CoulFMMEvaluator::init(const gcfmm::Options &options, FixSleepGran *sleep, bool virial,
+void CoulFMMEvaluator::init(const gcfmm::Options &options, Fix *sleep, bool virial,
                             bool distribute)
 {
   *opts = options;
@@ -167,7 +166,11 @@ void CoulFMMEvaluator::init(const gcfmm::Options &options, FixSleepGran *sleep, 
 
 void CoulFMMEvaluator::update_sleepers()
 {
-  if (sleepers) sleepers->use(sleep_fix->sleeping(), sleep_fix->generation());
+  if (!sleepers) return;
+  // fix sleep/gran's state, through its extract() names (fix_sleep_gran.h)
+  int dim = 0;
+  const auto *asleep = static_cast<const double *>(sleep_fix->extract("sleeping", dim));
+  sleepers->use(asleep, *static_cast<bigint *>(sleep_fix->extract("generation", dim)));
 }
 
 bool CoulFMMEvaluator::asleep(int i) const

@@ -34,7 +34,7 @@ struct Stats;
 
 namespace LAMMPS_NS {
 class CoulFMMSleepers;
-class FixSleepGran;
+class Fix;
 
 class CoulFMMEvaluator : protected Pointers {
  public:
@@ -51,7 +51,7 @@ class CoulFMMEvaluator : protected Pointers {
   // sleepers of `sleep` as a static source if given (errors for what cannot use them)
   // distribute: gcfmm::DistributedSolver (each rank keeps its charges), else gcfmm::Solver on
   // the charges of all ranks gathered on every rank
-  void init(const gcfmm::Options &opts, FixSleepGran *sleep, bool virial, bool distribute);
+  void init(const gcfmm::Options &opts, Fix *sleep, bool virial, bool distribute);
 
   // what the stored evaluation (state rows: CoulFMMTimeStepping::Column) belongs to: record()
   // it before an evaluation, continuity() relates it to the atoms now
@@ -105,7 +105,7 @@ class CoulFMMEvaluator : protected Pointers {
   std::vector<double> result, values, mine;
   double **fresh;    // the fresh evaluation of measure_error()
   int nmax_fresh;
-  FixSleepGran *sleep_fix;
+  Fix *sleep_fix;
   std::unique_ptr<CoulFMMSleepers> sleepers;
   double pair_energy;    // C/2 sum_awake q pot^sleepers at the last evaluation
   bool logged;

@@ -11,9 +11,8 @@
 
 #include "coul_fmm_comm.h"
 #include "coul_fmm_evaluator.h"
-#include "coul_fmm_near.h"
+#include "coul_fmm_near_refresh.h"
 #include "coul_fmm_polarizable.h"
-#include "fix_sleep_gran.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -235,7 +234,7 @@ void FixCoulFMM::init()
     return;
   }
   evaluator->init(
-      *opts, sleep.empty() || !sleepers_static ? nullptr : dynamic_cast<FixSleepGran *>(sleep[0]),
+      *opts, sleep.empty() || !sleepers_static ? nullptr : sleep[0],
       thermo_virial, distributed);
 
   const auto &mts = stepping->settings();
