@@ -7,7 +7,7 @@
    the GNU General Public License (same terms as LAMMPS).
 ------------------------------------------------------------------------- */
 
-#include "coul_fmm_near.h"
+#include "coul_fmm_near_refresh.h"
 
 #include "coul_fmm_time_stepping.h"
 
@@ -31,7 +31,7 @@ using MTS = CoulFMMTimeStepping;
 CoulFMMNearRefresh::CoulFMMNearRefresh(LAMMPS *lmp, Fix *owner) :
     Pointers(lmp), fix(owner), list(nullptr), delta(nullptr), near_now(nullptr), near_then(nullptr),
     nmax_delta(0), nmax_out(0), pair_now{}, pair_then{}, pair_dg{}, pair_r2now(nullptr),
-    pair_r2then(nullptr), simd_path(gcfmm::default_simd_path())
+    pair_r2then(nullptr), simd_path(gcsimd::default_simd_path())
 {
 }
 

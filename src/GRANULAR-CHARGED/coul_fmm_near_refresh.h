@@ -12,12 +12,12 @@
 // (forward-communicated to the ghosts through the fix) and the sum over the pairs; the pair
 // formula itself is CoulFMMTimeStepping::near_pair_change.
 
-#ifndef LMP_COUL_FMM_NEAR_H
-#define LMP_COUL_FMM_NEAR_H
+#ifndef LMP_COUL_FMM_NEAR_REFRESH_H
+#define LMP_COUL_FMM_NEAR_REFRESH_H
 
 #include "pointers.h"
 
-#include "gcfmm/simd.hpp"
+#include "gcsimd/simd.hpp"
 
 #include <utility>
 #include <vector>
@@ -57,7 +57,7 @@ class CoulFMMNearRefresh : protected Pointers {
   double *pair_now[3], *pair_then[3], *pair_dg[4], *pair_r2now, *pair_r2then;
   std::vector<int> pair_j;                      // the pairs' second atoms
   std::vector<std::pair<int, int>> pair_i;      // each first atom and the end of its pairs
-  gcfmm::SimdPath simd_path;
+  gcsimd::SimdPath simd_path;
   void grow_pairs(int n);
 };
 
