@@ -99,7 +99,7 @@ void CoulFMMPolarizable::gather()
   galpha.assign(gathered.size(), 0.0);
   if (s.polarize)
     for (size_t k = 0; k < gathered.size(); k++)
-      galpha[k] = gcfmm::polarizability(beta, gathered.extra[k]);
+      galpha[k] = gcfmm::polarizability(beta, gathered.radius[k]);
 }
 
 // this rank's atoms of the group and their index in the gathered order (binary search by ID)

@@ -92,7 +92,7 @@ class CoulFMMPolarizable : protected Pointers {
   int groupbit;
   std::unique_ptr<gcfmm::PolarizableSolver> solver;
   bool periodic = false;
-  // all atoms of the group, sorted by ID (radius as the extra value), their polarizabilities
+  // all atoms of the group, sorted by ID (with their radii), their polarizabilities
   // (bare units) and dipoles
   std::unique_ptr<CoulFMMComm> mpi;
   GatheredCharges gathered;

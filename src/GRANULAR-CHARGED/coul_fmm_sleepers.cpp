@@ -37,7 +37,7 @@ gcfmm::Options static_options(const gcfmm::Options &opts)
 
 CoulFMMSleepers::CoulFMMSleepers(LAMMPS *lmp, const gcfmm::Options &opts, int groupbit_in) :
     Pointers(lmp), field(new gcfmm::StaticSourceField(static_options(opts))), groupbit(groupbit_in),
-    flags(nullptr), generation(-1), built_generation(-2), built_box{0, 0, 0, 0, 0, 0}, nrebuilds(0)
+    flags(nullptr), generation(-1), built_generation(-2), built_box{0, 0, 0, 0, 0, 0}
 {
 }
 
@@ -79,7 +79,6 @@ void CoulFMMSleepers::prepare()
                      sources.q.data());
   built_generation = generation;
   std::copy(box, box + 6, built_box);
-  nrebuilds++;
 }
 
 double CoulFMMSleepers::add_field(const double *x, const double *y, const double *z,

@@ -50,8 +50,6 @@ class CoulFMMSleepers : protected Pointers {
   // change of the set
   double source_energy();
 
-  bigint nsources() const { return (bigint) sources.size(); }
-  bigint rebuilds() const { return nrebuilds; }
   double memory_usage() const;
   // ID of the sleeping atom at position k of the gathered set (error messages)
   tagint source_tag(size_t k) const { return k < sources.size() ? sources.tag[k] : -1; }
@@ -62,7 +60,6 @@ class CoulFMMSleepers : protected Pointers {
   const double *flags;
   bigint generation, built_generation;
   double built_box[6];
-  bigint nrebuilds;
   GatheredCharges sources;
   void gather();
 };
