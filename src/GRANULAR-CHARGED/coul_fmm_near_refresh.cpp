@@ -9,6 +9,8 @@
 
 #include "coul_fmm_near_refresh.h"
 
+#include "coul_fmm_state.h"
+
 #include "coul_fmm_time_stepping.h"
 
 #include "gcfmm/charge_pair_change.hpp"
@@ -55,7 +57,7 @@ void CoulFMMNearRefresh::request(double cutoff)
   }
 }
 
-void CoulFMMNearRefresh::compute(const MTS &scheme, double **eval_state, bool into_then,
+void CoulFMMNearRefresh::compute(const MTS &scheme, const CoulFMMState &state, bool into_then,
                                  double trend)
 {
   const int nlocal = atom->nlocal, nall = nlocal + atom->nghost;
@@ -77,7 +79,7 @@ void CoulFMMNearRefresh::compute(const MTS &scheme, double **eval_state, bool in
   double xu[3];
   for (int i = 0; i < nlocal; i++) {
     domain->unmap(x[i], atom->image[i], xu);
-    MTS::displacements(xu, eval_state[i], delta[i]);
+    MTS::displacements(xu, state.evaluation(i), delta[i]);
   }
   comm->forward_comm(fix);
   for (int i = 0; i < nlocal; i++)

@@ -37,7 +37,8 @@ class CoulFMMNearRefresh : protected Pointers {
 
   // C sum_j q_j (change of (K, 1/r) of pair ij since the evaluation) for the local atoms of the
   // group into now() (trend >= 0: between evaluations) or then() (trend < 0: the D of a slope)
-  void compute(const CoulFMMTimeStepping &scheme, double **eval_state, bool into_then, double trend);
+  void compute(const CoulFMMTimeStepping &scheme, const class CoulFMMState &state, bool into_then,
+               double trend);
   double **now() const { return near_now; }
   double **then() const { return near_then; }
 

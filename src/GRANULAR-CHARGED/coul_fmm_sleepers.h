@@ -41,7 +41,7 @@ class CoulFMMSleepers : protected Pointers {
 
   // rebuild the static source if the sleeping set, the cell or the z range changed; throws
   // what gcfmm throws
-  void prepare();
+  void prepare(const class CoulFMMBackend &backend);
   // ADD the sleepers' potential and field (bare 1/r kernel) at the targets [first, last) of
   // the gathered awake atoms; returns sum_t q_t pot_t over those targets
   double add_field(const double *x, const double *y, const double *z, const double *q,

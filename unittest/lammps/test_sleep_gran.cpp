@@ -161,28 +161,34 @@ TEST(FixSleepGran, SleeperIsAFixedBody)
   EXPECT_GT(std::abs(b.var("vz[2]") + 0.3), 0.01);
 }
 
-TEST(FixSleepGran, WakesWhenPushed)
+// sphere 3 below sphere 1, touching it: both sleep; sphere 2 hits 1. Below the wake threshold
+// nothing wakes; above it sphere 1 wakes, and sphere 3 with it
+void expect_wakes_when_pushed(const std::string &pair)
 {
-  if (nprocs() > 1) GTEST_SKIP() << "single-rank test";
-  // sphere 3 below sphere 1, touching it: both sleep; sphere 2 hits 1
-  auto cmds = impact("group bedg id 1 3");
+  auto cmds = impact("group bedg id 1 3", pair);
   {
     Lmp l;
     l.cmds(cmds);
-    l.cmd("fix sleep bedg sleep/gran speed 1e3 force 1.0 wake 1e3 time 0 every 1");
-    l.cmd("run 3000");
-    EXPECT_EQ(l.var("f_sleep[4]"), 0.0) << "push below wake: nothing wakes";
+    l.cmds({"fix sleep bedg sleep/gran speed 1e3 force 1e-6 wake 1e3 time 0 every 1", "run 3000"});
+    EXPECT_EQ(l.var("f_sleep[2]"), 2.0) << pair;
+    EXPECT_EQ(l.var("f_sleep[4]"), 0.0) << pair << ": push below wake, nothing wakes";
   }
   // the impact pushes with ~3e-8 N, m U / t_c (F_C = 3 pi gamma R = 9.4e-8 N)
   Lmp m;
   m.cmds(cmds);
   // the pair 1-3 snaps into JKR contact (3.6e-8 N): at rest means here a net force below 1e-6 N
   m.cmds({"fix sleep bedg sleep/gran speed 1e3 force 1e-6 wake 1e-8 time 0 every 1", "run 1"});
-  EXPECT_EQ(m.var("f_sleep[2]"), 2.0) << "both at rest at step 1";
+  EXPECT_EQ(m.var("f_sleep[2]"), 2.0) << pair << ": both at rest at step 1";
   const double z1 = m.var("z[1]");
   m.cmd("run 3000");
-  EXPECT_GE(m.var("f_sleep[4]"), 2.0) << "sphere 1 pushed, sphere 3 touching it";
-  EXPECT_NE(m.var("z[1]"), z1) << "sphere 1 moves once awake";
+  EXPECT_GE(m.var("f_sleep[4]"), 2.0) << pair << ": sphere 1 pushed, sphere 3 touching it";
+  EXPECT_NE(m.var("z[1]"), z1) << pair << ": sphere 1 moves once awake";
+}
+
+TEST(FixSleepGran, WakesWhenPushed)
+{
+  if (nprocs() > 1) GTEST_SKIP() << "single-rank test";
+  expect_wakes_when_pushed("granular/opt");
 }
 
 // the base style computes every contact; the fix finds the contacts and the push itself
@@ -200,23 +206,7 @@ TEST(FixSleepGran, BaseStyleHoldsAndWakes)
     const auto x1 = positions(l);
     for (size_t k = 0; k < x0.size(); ++k) EXPECT_EQ(x0[k], x1[k]) << "coordinate " << k;
   }
-  if (nprocs() > 1) return;    // the impact below is a single-rank set-up
-  auto cmds = impact("group bedg id 1 3", "granular");
-  {
-    Lmp l;
-    l.cmds(cmds);
-    l.cmds({"fix sleep bedg sleep/gran speed 1e3 force 1e-6 wake 1e3 time 0 every 1", "run 3000"});
-    EXPECT_EQ(l.var("f_sleep[2]"), 2.0);
-    EXPECT_EQ(l.var("f_sleep[4]"), 0.0) << "push below wake: nothing wakes";
-  }
-  Lmp m;
-  m.cmds(cmds);
-  m.cmds({"fix sleep bedg sleep/gran speed 1e3 force 1e-6 wake 1e-8 time 0 every 1", "run 1"});
-  EXPECT_EQ(m.var("f_sleep[2]"), 2.0) << "both at rest at step 1";
-  const double z1 = m.var("z[1]");
-  m.cmd("run 3000");
-  EXPECT_GE(m.var("f_sleep[4]"), 2.0) << "sphere 1 pushed, sphere 3 touching it";
-  EXPECT_NE(m.var("z[1]"), z1) << "sphere 1 moves once awake";
+  if (nprocs() == 1) expect_wakes_when_pushed("granular");    // a single-rank set-up
 }
 
 TEST(FixSleepGran, RestartKeepsTheFlags)
