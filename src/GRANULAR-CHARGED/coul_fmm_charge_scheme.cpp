@@ -161,10 +161,10 @@ bool CoulFMMChargeScheme::acts_on(int i) const
 }
 
 // the static sleepers' pair energy with the awake charges and among themselves
-double CoulFMMChargeScheme::extra_energy()
+double CoulFMMChargeScheme::total_energy(double atoms)
 {
-  if (!eval->split_active()) return 0.0;
-  return eval->sleeper_pair_energy() + eval->sleeper_source_energy();
+  if (!eval->split_active()) return atoms;
+  return atoms + eval->sleeper_pair_energy() + eval->sleeper_source_energy();
 }
 
 const CoulFMMScheme::Diagnostics &CoulFMMChargeScheme::diagnostics() const

@@ -33,7 +33,7 @@ class CoulFMMChargeScheme : public CoulFMMScheme, protected Pointers {
   bool continues() override;
   double compute(bool predict) override;
   bool acts_on(int i) const override;
-  double extra_energy() override;
+  double total_energy(double atoms) override;
   const Diagnostics &diagnostics() const override;
   double evaluations() const override { return nevaluations; }
   double memory_usage() const override;

@@ -63,8 +63,9 @@ class CoulFMMScheme {
   virtual double compute(bool predict) = 0;
   // atom i (local) receives a force
   virtual bool acts_on(int i) const = 0;
-  // energy that no atom's force carries (the static sleepers' pairs), summed over the ranks
-  virtual double extra_energy() { return 0.0; }
+  // the energy of all atoms (the ranks' sums of compute()) plus what no atom's force carries
+  // (the static sleepers' pairs)
+  virtual double total_energy(double atoms) { return atoms; }
   virtual const Diagnostics &diagnostics() const = 0;
   virtual double evaluations() const = 0;
   virtual double memory_usage() const = 0;

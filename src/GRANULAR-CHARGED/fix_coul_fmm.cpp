@@ -323,7 +323,7 @@ double FixCoulFMM::compute_scalar()
     backend->communication().sum(&energy_all, 1);
     energy_summed = true;
   }
-  return energy_all + scheme->extra_energy();
+  return scheme->total_energy(energy_all);
 }
 
 // doc/fix_coul_fmm.md, "Output": 1-4 solver (error estimate, order, M2L, P2P), 5-7 keyword
