@@ -647,7 +647,8 @@ void FixSleepGran::unpack_reverse_comm(int n, int *list, double *buf)
       push[j][2] += buf[m++];
       ncontact[j] += buf[m++];
     } else {
-      wake_mark[j] = MAX(wake_mark[j], buf[m++]);
+      const double mark = buf[m++];    // read once: MAX() would evaluate it twice
+      if (mark > wake_mark[j]) wake_mark[j] = mark;
     }
   }
 }
