@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The same deposition with two builds, started together (one per core), so that both see the
-# same machine: prints the user CPU seconds of each and their ratio.
+# same machine: prints the user CPU seconds of each and their ratio, both GC RESULT lines and
+# whether they and the final dumps are identical.
 #   bench/deposition/ab.sh <build-dir before> <build-dir after> [-var NAME VALUE ...]
 # e.g. bench/deposition/ab.sh /tmp/before build -var N 500 -var L_rp 14 -var q 400 -var seed 1
 # (a build dir holds lmp and liblammps.so.0; the deck is this checkout's, or for the build
@@ -27,6 +28,15 @@ for tag in before after; do
   phi=$(sed -n 's/^GC RESULT .* phi \([^ ]*\) Z \([^ ]*\).*/\1, <Z> \2/p' "$out/$tag/log.lammps" | tail -n 1)
   echo "$tag: $(tail -n 1 "$out/$tag/user") s user CPU, $steps steps, phi $phi"
 done
+for tag in before after; do
+  echo "$tag: $(grep '^GC RESULT' "$out/$tag/log.lammps" | tail -n 1)"
+done
+if [ "$(grep '^GC RESULT' "$out/before/log.lammps" | tail -n 1)" = \
+     "$(grep '^GC RESULT' "$out/after/log.lammps" | tail -n 1)" ]; then
+  echo "GC RESULT: identical"
+else
+  echo "GC RESULT: differs"
+fi
 if cmp -s "$out/before/final.dump" "$out/after/final.dump"; then
   echo "final.dump: identical"
 else

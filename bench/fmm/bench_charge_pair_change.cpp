@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "gcfmm/charge_pair_change.hpp"
-#include "gcfmm/simd.hpp"
+#include "gcsimd/simd.hpp"
 
 namespace {
 
@@ -61,15 +61,15 @@ int main(int argc, char **argv) {
   });
   std::printf("pairs %zu, repetitions %d\n%-28s %8s %10s\n", n, reps, "kernel", "ns/pair", "/ scalar");
   std::printf("%-28s %8.2f %10.3f\n", "scalar, pair by pair", t_scalar, 1.0);
-  for (gcfmm::SimdPath path : {gcfmm::SimdPath::Generic, gcfmm::SimdPath::AVX2, gcfmm::SimdPath::AVX512}) {
-    if (!gcfmm::simd_path_available(path)) continue;
+  for (gcsimd::SimdPath path : {gcsimd::SimdPath::Generic, gcsimd::SimdPath::AVX2, gcsimd::SimdPath::AVX512}) {
+    if (!gcsimd::simd_path_available(path)) continue;
     const gcfmm::Separations a{&now[0], &now[n], &now[2 * n]}, b{&then[0], &then[n], &then[2 * n]};
     const gcfmm::ChargePairChange o{&out[0], &out[n], &out[2 * n], &out[3 * n], &out[4 * n], &out[5 * n]};
     const double t = best_ns_per_pair(n, reps, [&] {
       gcfmm::charge_pair_change(n, a, b, o, path);
       sink += out[0];
     });
-    std::printf("charge_pair_change %-9s %8.2f %10.3f\n", gcfmm::simd_path_name(path), t, t / t_scalar);
+    std::printf("charge_pair_change %-9s %8.2f %10.3f\n", gcsimd::simd_path_name(path), t, t / t_scalar);
   }
   return sink == 12345.0;    // keeps the work
 }

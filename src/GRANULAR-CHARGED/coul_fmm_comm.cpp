@@ -25,17 +25,17 @@ using namespace LAMMPS_NS;
 ------------------------------------------------------------------------- */
 
 void CoulFMMComm::gather(const std::function<bool(int)> &take, GatheredCharges &out,
-                         const double *extra)
+                         const double *radius)
 {
   double **x = atom->x;
   double *q = atom->q;
   tagint *tag = atom->tag;
-  const int per = extra ? 6 : 5;
+  const int per = radius ? 6 : 5;
   buf.clear();
   for (int i = 0; i < atom->nlocal; i++) {
     if (!take(i)) continue;
     buf.insert(buf.end(), {(double) tag[i], x[i][0], x[i][1], x[i][2], q[i]});
-    if (extra) buf.push_back(extra[i]);
+    if (radius) buf.push_back(radius[i]);
   }
 
   const int nprocs = comm->nprocs;
@@ -64,7 +64,7 @@ void CoulFMMComm::gather(const std::function<bool(int)> &take, GatheredCharges &
   out.y.resize(n);
   out.z.resize(n);
   out.q.resize(n);
-  out.extra.resize(extra ? n : 0);
+  out.radius.resize(radius ? n : 0);
   for (size_t k = 0; k < n; k++) {
     const double *r = &all[per * out.order[k]];
     out.tag[k] = (tagint) r[0];
@@ -72,7 +72,7 @@ void CoulFMMComm::gather(const std::function<bool(int)> &take, GatheredCharges &
     out.y[k] = r[2];
     out.z[k] = r[3];
     out.q[k] = r[4];
-    if (extra) out.extra[k] = r[5];
+    if (radius) out.radius[k] = r[5];
   }
 }
 
@@ -124,79 +124,4 @@ bool CoulFMMComm::any(bool flag)
   int mine = flag ? 1 : 0, all_flags = 0;
   MPI_Allreduce(&mine, &all_flags, 1, MPI_INT, MPI_MAX, world);
   return all_flags != 0;
-}
-
-/* ----------------------------------------------------------------------
-   gcfmm::Communicator over the world communicator. alltoallv first exchanges the byte counts
-   (MPI_Alltoall), then the bytes in one MPI_Alltoallv; counts and offsets are int, so one
-   rank's messages must stay below 2 GiB in total (an error otherwise).
-------------------------------------------------------------------------- */
-
-CoulFMMCollectives::CoulFMMCollectives(LAMMPS *lmp_in) :
-    lmp(lmp_in), world(lmp_in->world), me(lmp_in->comm->me), nprocs(lmp_in->comm->nprocs)
-{
-}
-
-void CoulFMMCollectives::allreduce_sum(double *data, std::size_t count)
-{
-  MPI_Allreduce(MPI_IN_PLACE, data, (int) count, MPI_DOUBLE, MPI_SUM, world);
-  if (nprocs > 1) received += (double) count * sizeof(double);
-}
-
-void CoulFMMCollectives::allreduce_max(double *data, std::size_t count)
-{
-  MPI_Allreduce(MPI_IN_PLACE, data, (int) count, MPI_DOUBLE, MPI_MAX, world);
-  if (nprocs > 1) received += (double) count * sizeof(double);
-}
-
-void CoulFMMCollectives::allgather(const double *mine, std::size_t count, double *out)
-{
-  MPI_Allgather(mine, (int) count, MPI_DOUBLE, out, (int) count, MPI_DOUBLE, world);
-  received += (double) count * (nprocs - 1) * sizeof(double);
-}
-
-void CoulFMMCollectives::alltoallv(const std::vector<std::vector<unsigned char>> &send,
-                                   std::vector<std::vector<unsigned char>> &recv)
-{
-  std::vector<int> scount(nprocs), rcount(nprocs), sdispl(nprocs), rdispl(nprocs);
-  double stotal = 0.0, rtotal = 0.0;
-  for (int p = 0; p < nprocs; p++) {
-    scount[p] = p < (int) send.size() ? (int) send[p].size() : 0;
-    stotal += scount[p];
-  }
-  MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, world);
-  for (int p = 0; p < nprocs; p++) rtotal += rcount[p];
-  const double limit = (double) MAXSMALLINT;
-  int too_large = (stotal > limit || rtotal > limit) ? 1 : 0, any = 0;
-  MPI_Allreduce(&too_large, &any, 1, MPI_INT, MPI_MAX, world);
-  if (any)
-    lmp->error->all(
-        FLERR,
-        "Fix coul/fmm: a rank would exchange more than 2 GiB of local essential "
-        "tree in one evaluation (sent {:.3g}, received {:.3g} bytes here): use more ranks",
-        stotal, rtotal);
-  int soff = 0, roff = 0;
-  for (int p = 0; p < nprocs; p++) {
-    sdispl[p] = soff;
-    rdispl[p] = roff;
-    soff += scount[p];
-    roff += rcount[p];
-  }
-  bytes_out.resize(soff);
-  for (int p = 0; p < nprocs; p++)
-    if (scount[p]) std::copy(send[p].begin(), send[p].end(), bytes_out.begin() + sdispl[p]);
-  bytes_in.resize(roff);
-  MPI_Alltoallv(bytes_out.data(), scount.data(), sdispl.data(), MPI_UNSIGNED_CHAR, bytes_in.data(),
-                rcount.data(), rdispl.data(), MPI_UNSIGNED_CHAR, world);
-  recv.resize(nprocs);
-  for (int p = 0; p < nprocs; p++)
-    recv[p].assign(bytes_in.begin() + rdispl[p], bytes_in.begin() + rdispl[p] + rcount[p]);
-  received += rtotal - rcount[me] + (double) (nprocs - 1) * sizeof(int);
-}
-
-double CoulFMMCollectives::take_received_bytes()
-{
-  const double bytes = received;
-  received = 0.0;
-  return bytes;
 }

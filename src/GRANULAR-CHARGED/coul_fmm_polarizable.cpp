@@ -9,15 +9,22 @@
 
 #include "coul_fmm_polarizable.h"
 
+#include "coul_fmm_backend.h"
+#include "coul_fmm_state.h"
+#include "coul_fmm_time_stepping.h"
+
 #include "coul_fmm_comm.h"
 
 #include "atom.h"
+#include "fix.h"
+#include "modify.h"
 #include "comm.h"
 #include "domain.h"
 #include "error.h"
 #include "force.h"
 #include "update.h"
 
+#include "gcfmm/coulomb_backend.hpp"
 #include "gcfmm/dipole_kernels.hpp"
 #include "gcfmm/far_field.hpp"
 #include "gcfmm/near_pair_change.hpp"
@@ -31,14 +38,87 @@
 
 using namespace LAMMPS_NS;
 
-CoulFMMPolarizable::CoulFMMPolarizable(LAMMPS *lmp, const Settings &settings, int groupbit_) :
-    Pointers(lmp), s(settings), groupbit(groupbit_), mpi(new CoulFMMComm(lmp))
+CoulFMMPolarizable::CoulFMMPolarizable(LAMMPS *lmp, const Settings &settings, const Parts &p) :
+    Pointers(lmp), s(settings), parts(p), groupbit(p.fix->groupbit), backend(*p.backend),
+    mpi(p.backend->communication())
 {
 }
 
 CoulFMMPolarizable::~CoulFMMPolarizable() = default;
 
-void CoulFMMPolarizable::init(const gcfmm::Options &opts)
+/* ----------------------------------------------------------------------
+   doc/fix_coul_fmm.md, "Applied field, induced dipoles, electrode": every step, replicated
+------------------------------------------------------------------------- */
+
+void CoulFMMPolarizable::init()
+{
+  check_combinations();
+  // the multiple time stepping of doc/polarization.md, section 8: the near pairs' change with
+  // the dipoles held, the far part extrapolated (or held), no keyword check
+  const auto &mts = parts.stepping->settings();
+  const double half_cell = 0.5 * MIN(domain->xprd, domain->yprd);
+  if (parts.opts->boundary == gcfmm::Boundary::Periodic2D && mts.every > 1 &&
+      mts.near_cutoff >= half_cell)
+    error->all(FLERR,
+               "Fix coul/fmm near {:g} with efield, polarize or electrode must be smaller than "
+               "half the periodic cell ({:g})",
+               mts.near_cutoff, half_cell);
+  init_solver(*parts.opts);
+  set_time_stepping(mts.every > 1 ? mts.near_cutoff : 0.0, mts.every > 1,
+                    mts.every > 1 && mts.extrapolate);
+}
+
+void CoulFMMPolarizable::check_combinations()
+{
+  if (parts.distributed)
+    error->all(FLERR, "Fix coul/fmm efield, polarize and electrode need solver replicated");
+  if (!modify->get_fix_by_style("^sleep/gran$").empty() && parts.sleepers_static)
+    error->all(FLERR,
+               "Fix coul/fmm efield, polarize and electrode need sleepers full with fix "
+               "sleep/gran (the static sleepers' field has no dipoles or images)");
+  // LAMMPS's fix efield pushes the charges only: with efield here it would count the field
+  // twice, with polarize it would leave the dipoles blind to it
+  if (!modify->get_fix_by_style("^efield").empty()) {
+    if (s.efield)
+      error->all(FLERR, "Fix coul/fmm efield and fix efield would both apply the field: use one");
+    if (s.polarize)
+      error->all(FLERR,
+                 "Fix coul/fmm polarize with fix efield: fix efield's field would not "
+                 "polarize the particles; give it to fix coul/fmm efield instead");
+  }
+  if (parts.stepping->settings().check_every > 0 && comm->me == 0)
+    error->warning(FLERR,
+                   "Fix coul/fmm {}: check is ignored with efield, polarize or electrode (the "
+                   "error of the time stepping is measured at every evaluation, vector element 9)",
+                   parts.fix->id);
+}
+
+// F_i = q_i E_i + (p_i . grad) E_i and the energy of doc/polarization.md, eq. (3.4), evaluated
+// on the schedule's steps and continued between them (section 8)
+double CoulFMMPolarizable::compute(bool predict)
+{
+  CoulFMMTimeStepping &stepping = *parts.stepping;
+  CoulFMMState &state = *parts.state;
+  const bigint step = update->ntimestep;
+  double energy = 0.0;
+  const bool continued = predict && !stepping.scheduled(step) &&
+      advance(state.field_rows(), state.force_rows(), energy);
+  if (continued) return energy;
+  energy = evaluate(state.field_rows(), state.force_rows(), predict, stepping.stride());
+  nevaluations += 1.0;
+  if (predict) {
+    if (prediction_error() >= 0.0) stepping.adapt(prediction_error());
+    stepping.evaluated.step = step;
+  }
+  return energy;
+}
+
+bool CoulFMMPolarizable::acts_on(int i) const
+{
+  return (atom->mask[i] & groupbit) != 0;
+}
+
+void CoulFMMPolarizable::init_solver(const gcfmm::Options &opts)
 {
   if (s.polarize && !atom->radius_flag)
     error->all(FLERR,
@@ -68,12 +148,13 @@ void CoulFMMPolarizable::init(const gcfmm::Options &opts)
   gcfmm::PolarizationSettings induction;
   induction.tolerance = s.tolerance > 0.0 ? s.tolerance : 0.1 * opts.accuracy;
   induction_tolerance = induction.tolerance;
-  solver = std::make_unique<gcfmm::PolarizableSolver>(opts, s.polarize);
-  solver->set_induction(induction);
+  backend.create(CoulFMMBackend::Kind::POLARIZABLE, opts, s.polarize);
+  gcfmm::PolarizableSolver &solver = backend.polarizable().solver();
+  solver.set_induction(induction);
   // every rank computes its share of the targets of each evaluation, one sum completes them
   // (each value comes from one rank: the same result as on one rank)
   if (comm->nprocs > 1)
-    solver->set_partition(comm->me, comm->nprocs, [this](double *data, std::size_t count) {
+    solver.set_partition(comm->me, comm->nprocs, [this](double *data, std::size_t count) {
       MPI_Allreduce(MPI_IN_PLACE, data, (int) count, MPI_DOUBLE, MPI_SUM, world);
     });
   gcfmm::PolarizableEnvironment env;
@@ -83,7 +164,7 @@ void CoulFMMPolarizable::init(const gcfmm::Options &opts)
   applied = env.applied_field;
   env.electrode = s.electrode;
   env.electrode_z = s.electrode_z;
-  solver->set_environment(env);
+  solver.set_environment(env);
 }
 
 // every rank: the group's atoms of all ranks, sorted by ID (CoulFMMComm::gather), with their
@@ -91,7 +172,7 @@ void CoulFMMPolarizable::init(const gcfmm::Options &opts)
 void CoulFMMPolarizable::gather()
 {
   const int bit = groupbit;
-  mpi->gather([this, bit](int i) { return (atom->mask[i] & bit) != 0; }, gathered,
+  mpi.gather([this, bit](int i) { return (atom->mask[i] & bit) != 0; }, gathered,
               s.polarize ? atom->radius : nullptr);
   const double beta = s.polarize
       ? gcfmm::clausius_mossotti(s.eps_particle, s.eps_medium > 0.0 ? s.eps_medium : force->dielectric)
@@ -99,7 +180,7 @@ void CoulFMMPolarizable::gather()
   galpha.assign(gathered.size(), 0.0);
   if (s.polarize)
     for (size_t k = 0; k < gathered.size(); k++)
-      galpha[k] = gcfmm::polarizability(beta, gathered.extra[k]);
+      galpha[k] = gcfmm::polarizability(beta, gathered.radius[k]);
 }
 
 // this rank's atoms of the group and their index in the gathered order (binary search by ID)
@@ -158,13 +239,14 @@ bool CoulFMMPolarizable::continue_last(gcfmm::NearChange &change, const std::vec
     return true;
   }
   bool done = false;
-  try {
-    done = near->compute(n, now.data(), then.data(), eval.q.data(), s.polarize ? eval.p.data() : nullptr,
-                         targets.data(), targets.size(), change);
-  } catch (std::exception &e) {
-    const std::string below = below_electrode();
-    error->all(FLERR, "Fix coul/fmm: {}", below.empty() ? std::string(e.what()) : below);
-  }
+  backend.run(
+      [&] {
+        done = near->compute(n, now.data(), then.data(), eval.q.data(),
+                             s.polarize ? eval.p.data() : nullptr, targets.data(), targets.size(),
+                             change);
+      },
+      [this](size_t k) { return gathered.tag[k % gathered.size()]; }, true,
+      [this] { return below_electrode(); });
   return done;
 }
 
@@ -177,7 +259,7 @@ double CoulFMMPolarizable::store(double **field, double **force_out, const gcfmm
     for (int k = 0; k < cols; k++) field[i][k] = 0.0;
     for (int k = 0; k < 3; k++) force_out[i][k] = 0.0;
   }
-  const double c = force->qqrd2e;
+  const double c = backend.scale();
   double energy = 0.0;
   for (size_t t = 0; t < local_k.size(); t++) {
     const int i = local_i[t];
@@ -248,31 +330,43 @@ double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool pre
     for (int a = 0; a < 3; a++)
       gp[3 * k + a] = both ? 2.0 * last_p[3 * m + a] - prev_p[3 * l + a] : last_p[3 * m + a];
   }
-  gcfmm::PolarizableOutputs out;
-  std::string failure;
-  try {
-    if (periodic) {
-      solver->set_box(domain->boxlo[0], domain->boxlo[1], domain->xprd, domain->yprd);
-      solver->set_z_range(domain->boxlo[2], domain->boxhi[2]);
-    }
-    solver->compute(n, gathered.x.data(), gathered.y.data(), gz.data(), gathered.q.data(),
-                    s.polarize ? galpha.data() : nullptr, gp.data(), out);
-  } catch (gcfmm::CoincidentParticles &e) {
-    // the solver's sources are the atoms, then (with an electrode) their images
-    failure = fmt::format("atoms {} and {} are at the same position: their Coulomb force is not "
-                          "defined", gtag[e.first() % n], gtag[e.second() % n]);
-  } catch (std::exception &e) {
-    failure = e.what();
-  }
-  // every rank solved the same system, so every rank sees the same failure; the solver names
-  // the particle by its index in the sorted list: name the atom instead
-  if (!failure.empty()) {
-    const std::string below = below_electrode();
-    error->all(FLERR, "Fix coul/fmm: {}", below.empty() ? failure : below);
-  }
-  const auto &rep = solver->report();
+  // the solver's sources are the atoms, then (with an electrode) their images: every rank
+  // solves the same system, so every rank sees the same failure
+  eval.field.resize(3 * n);
+  eval.force.resize(3 * n);
+  eval.energy.resize(n);
+  std::vector<double> e3(3 * n);
+  gcfmm::BackendInput in;
+  in.n = n;
+  in.x = gathered.x.data();
+  in.y = gathered.y.data();
+  in.z = gz.data();
+  in.q = gathered.q.data();
+  in.alpha = s.polarize ? galpha.data() : nullptr;
+  in.p = gp.data();
+  gcfmm::BackendOutput out;
+  out.ex = e3.data();
+  out.ey = e3.data() + n;
+  out.ez = e3.data() + 2 * n;
+  out.force = eval.force.data();
+  out.energy = eval.energy.data();
+  backend.run(
+      [&] {
+        backend.set_cell();
+        backend.solver().evaluate(in, out);
+      },
+      [&](size_t k) { return gtag[k % n]; }, true, [this] { return below_electrode(); });
+  for (size_t k = 0; k < n; k++)
+    for (int a = 0; a < 3; a++) eval.field[3 * k + a] = e3[a * n + k];
+  const gcfmm::BackendStats rep = backend.solver().stats();
   last_iterations = rep.iterations;
   last_residual = rep.residual;
+  diag.estimated_error = rep.estimated_error;
+  diag.order = rep.order;
+  diag.m2l = rep.m2l;
+  diag.p2p = rep.p2p;
+  diag.iterations = rep.iterations;
+  diag.residual = rep.residual;
   if (s.polarize && !rep.converged)
     error->all(FLERR,
                "Fix coul/fmm polarize: the induced dipoles did not converge (residual {:.3g} > "
@@ -296,9 +390,6 @@ double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool pre
     eval.x[3 * k + 2] = gz[k];
   }
   eval.p = gp;
-  eval.field = out.field;
-  eval.force = out.force;
-  eval.energy = out.energy;
   if (near_cutoff > 0.0) {
     gcfmm::NearGeometry geo;
     geo.periodic = periodic;
@@ -317,38 +408,24 @@ double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool pre
   if (held.empty()) {
     eval.slope.assign(3 * n, 0.0);
   } else {
+    using MTS = CoulFMMTimeStepping;
     double sums[2] = {0.0, 0.0};
-    for (size_t k = 0; k < 3 * n; k++) {
-      const double predicted = held[k] + (extrapolate ? steps * eval.slope[k] : 0.0);
-      sums[0] += (predicted - out.force[k]) * (predicted - out.force[k]);
-      sums[1] += out.force[k] * out.force[k];
+    for (size_t k = 0; k < n; k++) {
+      double predicted[3];
+      for (int a = 0; a < 3; a++)
+        predicted[a] = held[3 * k + a] + (extrapolate ? steps * eval.slope[3 * k + a] : 0.0);
+      MTS::add_error_sums(1.0, predicted, &eval.force[3 * k], sums);
     }
-    last_prediction_error = sums[1] > 0.0 ? std::sqrt(sums[0] / sums[1]) : 0.0;
+    last_prediction_error = MTS::relative_rms(sums);
     if (!extrapolate)
       eval.slope.assign(3 * n, 0.0);
     else if (steps >= stride)
-      for (size_t k = 0; k < 3 * n; k++) eval.slope[k] = (out.force[k] - held[k]) / steps;
+      for (size_t k = 0; k < 3 * n; k++) eval.slope[k] = MTS::slope(eval.force[k], held[k], steps);
   }
   eval.step = step;
   return store(field, force_out, nullptr, 0.0);
 }
 
-double CoulFMMPolarizable::estimated_error() const
-{
-  return solver ? solver->stats().estimated_error : 0.0;
-}
-int CoulFMMPolarizable::order() const
-{
-  return solver ? solver->stats().order : 0;
-}
-double CoulFMMPolarizable::m2l() const
-{
-  return solver ? (double) solver->stats().m2l_count : 0.0;
-}
-double CoulFMMPolarizable::p2p() const
-{
-  return solver ? (double) solver->stats().p2p_pairs : 0.0;
-}
 
 double CoulFMMPolarizable::memory_usage() const
 {

@@ -21,6 +21,7 @@
 #define LMP_COUL_FMM_POLARIZABLE_H
 
 #include "coul_fmm_comm.h"
+#include "coul_fmm_scheme.h"
 #include "pointers.h"
 
 #include "gcfmm/types.hpp"
@@ -31,14 +32,13 @@
 
 namespace gcfmm {
 class NearPairChange;
-class PolarizableSolver;
 struct NearChange;
 struct Options;
 }    // namespace gcfmm
 
 namespace LAMMPS_NS {
 
-class CoulFMMPolarizable : protected Pointers {
+class CoulFMMPolarizable : public CoulFMMScheme, protected Pointers {
  public:
   // what the keywords ask for (LAMMPS units: the field as for fix efield, force = qe2f q E)
   struct Settings {
@@ -51,11 +51,18 @@ class CoulFMMPolarizable : protected Pointers {
     double electrode_z = 0.0;
     double tolerance = 0.0;    // induction residual; 0: 0.1 x accuracy
   };
-  CoulFMMPolarizable(class LAMMPS *, const Settings &, int groupbit);
+  CoulFMMPolarizable(class LAMMPS *, const Settings &, const Parts &);
   ~CoulFMMPolarizable() override;
 
-  // checks against the atoms and the box, and a solver for the options (set_geometry applied)
-  void init(const gcfmm::Options &opts);
+  // CoulFMMScheme: evaluations on the schedule's steps, continued in between (advance)
+  // (doc/polarization.md, section 8); a minimizer's call always evaluates
+  void init() override;
+  bool continues() override { return false; }    // an evaluation at every setup
+  double compute(bool predict) override;
+  bool acts_on(int i) const override;
+  const Diagnostics &diagnostics() const override { return diag; }
+  double evaluations() const override { return nevaluations; }
+
   // field[i][0..3] = Ex, Ey, Ez (applied field included) and the potential of the charges;
   // field[i][4..6] = the dipole (charge x distance; polarize only); force[i][0..2] = q E + (p . grad) E, all in
   // LAMMPS units, zero outside the group; returns this rank's part of the energy
@@ -77,24 +84,25 @@ class CoulFMMPolarizable : protected Pointers {
   // the group's charged and polarizable atoms); -1 if that evaluation continued nothing
   double prediction_error() const { return last_prediction_error; }
 
-  // the solver's error estimate, order, M2L and P2P counts of the last evaluation
-  double estimated_error() const;
-  int order() const;
-  double m2l() const;
-  double p2p() const;
   int iterations() const { return last_iterations; }
   double residual() const { return last_residual; }
   const Settings &settings() const { return s; }
-  double memory_usage() const;
+  double memory_usage() const override;
 
  private:
   Settings s;
+  Parts parts;
   int groupbit;
-  std::unique_ptr<gcfmm::PolarizableSolver> solver;
+  Diagnostics diag;
+  double nevaluations = 0.0;
+  void check_combinations();
+  // checks against the atoms and the box, and a solver for the options (set_geometry applied)
+  void init_solver(const gcfmm::Options &opts);
+  class CoulFMMBackend &backend;    // the fix's, holding a gcfmm::PolarizableBackend
   bool periodic = false;
-  // all atoms of the group, sorted by ID (radius as the extra value), their polarizabilities
+  // all atoms of the group, sorted by ID (with their radii), their polarizabilities
   // (bare units) and dipoles
-  std::unique_ptr<CoulFMMComm> mpi;
+  CoulFMMComm &mpi;
   GatheredCharges gathered;
   std::vector<double> galpha, gp;
   // the last two solutions, by atom ID (sorted), and their steps: the warm start is the last

@@ -9,6 +9,8 @@
 
 #include "coul_fmm_sleepers.h"
 
+#include "coul_fmm_backend.h"
+
 #include "coul_fmm_comm.h"
 
 #include "atom.h"
@@ -37,7 +39,7 @@ gcfmm::Options static_options(const gcfmm::Options &opts)
 
 CoulFMMSleepers::CoulFMMSleepers(LAMMPS *lmp, const gcfmm::Options &opts, int groupbit_in) :
     Pointers(lmp), field(new gcfmm::StaticSourceField(static_options(opts))), groupbit(groupbit_in),
-    flags(nullptr), generation(-1), built_generation(-2), built_box{0, 0, 0, 0, 0, 0}, nrebuilds(0)
+    flags(nullptr), generation(-1), built_generation(-2), built_box{0, 0, 0, 0, 0, 0}
 {
 }
 
@@ -61,25 +63,19 @@ void CoulFMMSleepers::gather()
       sources);
 }
 
-void CoulFMMSleepers::prepare()
+void CoulFMMSleepers::prepare(const CoulFMMBackend &backend)
 {
   const double box[6] = {domain->boxlo[0], domain->boxlo[1], domain->xprd,
                          domain->yprd,     domain->boxlo[2], domain->boxhi[2]};
-  const bool periodic = domain->xperiodic && domain->yperiodic;
   bool same_box = true;
   for (int k = 0; k < 6; k++) same_box = same_box && box[k] == built_box[k];
   if (generation == built_generation && same_box) return;
   gather();
-  if (periodic) {
-    field->set_box(box[0], box[1], box[2], box[3]);
-    // boundary f in z keeps every atom in the box: one far-field column for the run
-    field->set_z_range(box[4], box[5]);
-  }
+  backend.set_cell_of(*field);
   field->set_sources(sources.size(), sources.x.data(), sources.y.data(), sources.z.data(),
                      sources.q.data());
   built_generation = generation;
   std::copy(box, box + 6, built_box);
-  nrebuilds++;
 }
 
 double CoulFMMSleepers::add_field(const double *x, const double *y, const double *z,

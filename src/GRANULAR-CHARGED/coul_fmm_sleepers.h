@@ -41,7 +41,7 @@ class CoulFMMSleepers : protected Pointers {
 
   // rebuild the static source if the sleeping set, the cell or the z range changed; throws
   // what gcfmm throws
-  void prepare();
+  void prepare(const class CoulFMMBackend &backend);
   // ADD the sleepers' potential and field (bare 1/r kernel) at the targets [first, last) of
   // the gathered awake atoms; returns sum_t q_t pot_t over those targets
   double add_field(const double *x, const double *y, const double *z, const double *q,
@@ -50,8 +50,6 @@ class CoulFMMSleepers : protected Pointers {
   // change of the set
   double source_energy();
 
-  bigint nsources() const { return (bigint) sources.size(); }
-  bigint rebuilds() const { return nrebuilds; }
   double memory_usage() const;
   // ID of the sleeping atom at position k of the gathered set (error messages)
   tagint source_tag(size_t k) const { return k < sources.size() ? sources.tag[k] : -1; }
@@ -62,7 +60,6 @@ class CoulFMMSleepers : protected Pointers {
   const double *flags;
   bigint generation, built_generation;
   double built_box[6];
-  bigint nrebuilds;
   GatheredCharges sources;
   void gather();
 };

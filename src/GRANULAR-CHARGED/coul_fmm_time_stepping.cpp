@@ -148,7 +148,7 @@ void CoulFMMTimeStepping::end_evaluation(const Plan &p, double *st, const double
   add_error_sums(q2, predicted, &st[FIELD], sums);
   // S = (E(t) - E(t_e) - D) / (t - t_e); begin_evaluation put E(t_e) + D into the slope
   if (p.new_slope)
-    for (int k = 0; k < 4; k++) st[SLOPE + k] = (st[FIELD + k] - st[SLOPE + k]) / p.steps;
+    for (int k = 0; k < 4; k++) st[SLOPE + k] = slope(st[FIELD + k], st[SLOPE + k], p.steps);
 }
 
 void CoulFMMTimeStepping::finish_evaluation(const Plan &p, double error)

@@ -140,6 +140,8 @@ class CoulFMMTimeStepping {
                              double sums[2]);
   // sqrt(sums[0] / sums[1]), 0 without a reference field
   static double relative_rms(const double sums[2]);
+  // the change per step of a value that went from `then` to `now` over `steps` steps
+  static double slope(double now, double then, double steps) { return (now - then) / steps; }
 
   // keyword check: one measurement (global sums of add_error_sums)
   void record_check(const double sums[2]);

@@ -9,11 +9,11 @@
 
 #include "fix_coul_fmm.h"
 
-#include "coul_fmm_comm.h"
-#include "coul_fmm_evaluator.h"
-#include "coul_fmm_near.h"
+#include "coul_fmm_backend.h"
+#include "coul_fmm_charge_scheme.h"
+#include "coul_fmm_near_refresh.h"
 #include "coul_fmm_polarizable.h"
-#include "fix_sleep_gran.h"
+#include "coul_fmm_state.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -25,12 +25,8 @@
 #include "respa.h"
 #include "update.h"
 
-#include "gcfmm/far_field.hpp"
 #include "gcfmm/options.hpp"
-#include "gcfmm/solver.hpp"
 
-#include <algorithm>
-#include <cmath>
 #include <exception>
 #include <map>
 #include <vector>
@@ -40,10 +36,10 @@ using namespace FixConst;
 using MTS = CoulFMMTimeStepping;
 
 FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), opts(new gcfmm::Options), mpi(new CoulFMMComm(lmp)),
-    near(new CoulFMMNearRefresh(lmp, this)), bed_given(false), sleepers_static(true),
-    distributed(false), nevaluations(0), energy_local(0.0), energy_all(0.0), energy_summed(false),
-    ilevel_respa(0), field_cols(4), polar_force(nullptr), field(nullptr), eval_state(nullptr)
+    Fix(lmp, narg, arg), opts(new gcfmm::Options), backend(new CoulFMMBackend(lmp)),
+    near(new CoulFMMNearRefresh(lmp, this)), field_cols(4), bed_given(false),
+    sleepers_static(true), distributed(false), energy_local(0.0), energy_all(0.0),
+    energy_summed(false), ilevel_respa(0)
 {
   scalar_flag = 1;
   extscalar = 1;
@@ -65,12 +61,38 @@ FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
 
   parse_keywords(narg, arg);
   size_peratom_cols = field_cols;
-  evaluator = std::make_unique<CoulFMMEvaluator>(lmp, id, groupbit);
   FixCoulFMM::grow_arrays(atom->nmax);
   atom->add_callback(Atom::GROW);
   atom->add_callback(Atom::RESTART);
   for (int i = 0; i < atom->nlocal; i++) FixCoulFMM::set_arrays(i);
 }
+
+namespace {
+// keywords efield, polarize, electrode and induction, with their nvals values
+void parse_polar(LAMMPS *lmp, int iarg, int nvals, char **arg, CoulFMMPolarizable::Settings &polar)
+{
+  Error *error = lmp->error;
+  const std::string key = arg[iarg], v = arg[iarg + 1];
+  if (key == "efield") {
+    polar.efield = true;
+    for (int a = 0; a < 3; a++) polar.field[a] = utils::numeric(FLERR, arg[iarg + 1 + a], false, lmp);
+  } else if (key == "polarize") {
+    polar.polarize = true;
+    polar.eps_particle = utils::numeric(FLERR, v, false, lmp);
+    if (nvals == 2) polar.eps_medium = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
+    if (!(polar.eps_particle > 0.0) || (nvals == 2 && !(polar.eps_medium > 0.0)))
+      error->all(FLERR, iarg, "Fix coul/fmm polarize: permittivities must be > 0, got {}{}", v,
+                 nvals == 2 ? std::string(" ") + arg[iarg + 2] : std::string());
+  } else if (key == "electrode") {
+    polar.electrode = true;
+    polar.electrode_z = utils::numeric(FLERR, v, false, lmp);
+  } else if (key == "induction") {
+    polar.tolerance = utils::numeric(FLERR, v, false, lmp);
+    if (!(polar.tolerance > 0.0 && polar.tolerance < 1.0))
+      error->all(FLERR, iarg, "Fix coul/fmm induction must be in (0, 1), got {}", v);
+  }
+}
+}    // namespace
 
 void FixCoulFMM::parse_keywords(int narg, char **arg)
 {
@@ -116,34 +138,26 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
       opts->bed_zlo = utils::numeric(FLERR, v, false, lmp);
       opts->bed_zhi = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
       bed_given = true;
-    } else if (key == "efield") {
-      polar.efield = true;
-      for (int a = 0; a < 3; a++) polar.field[a] = utils::numeric(FLERR, arg[iarg + 1 + a], false, lmp);
-    } else if (key == "polarize") {
-      polar.polarize = true;
-      polar.eps_particle = utils::numeric(FLERR, v, false, lmp);
-      if (nvals == 2) polar.eps_medium = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
-      if (!(polar.eps_particle > 0.0) || (nvals == 2 && !(polar.eps_medium > 0.0)))
-        error->all(FLERR, iarg, "Fix coul/fmm polarize: permittivities must be > 0, got {}{}", v,
-                   nvals == 2 ? std::string(" ") + arg[iarg + 2] : std::string());
-    } else if (key == "electrode") {
-      polar.electrode = true;
-      polar.electrode_z = utils::numeric(FLERR, v, false, lmp);
-    } else if (key == "induction") {
-      polar.tolerance = utils::numeric(FLERR, v, false, lmp);
-      if (!(polar.tolerance > 0.0 && polar.tolerance < 1.0))
-        error->all(FLERR, iarg, "Fix coul/fmm induction must be in (0, 1), got {}", v);
+    } else {
+      parse_polar(lmp, iarg, nvals, arg, polar);
     }
     if (key == "images" || key == "farfield") periodic_keyword = key;
     if (key == "efield" || key == "polarize" || key == "electrode") any_polar = true;
     iarg += 1 + nvals;
   }
-  if (any_polar) {
-    polarizable = std::make_unique<CoulFMMPolarizable>(lmp, polar, groupbit);
-    if (polar.polarize) field_cols = 7;
-  } else if (polar.tolerance > 0.0) {
-    error->all(FLERR, "Fix coul/fmm induction needs polarize");
-  }
+  if (!any_polar && polar.tolerance > 0.0) error->all(FLERR, "Fix coul/fmm induction needs polarize");
+  if (polar.polarize) field_cols = 7;
+  create_parts(mts);
+  if (any_polar)
+    scheme = std::make_unique<CoulFMMPolarizable>(lmp, polar, parts());
+  else
+    scheme = std::make_unique<CoulFMMChargeScheme>(lmp, parts());
+}
+
+
+// the checked options and schedule, and the state
+void FixCoulFMM::create_parts(const MTS::Settings &mts)
+{
   // each value is checked once, by gcfmm::Options and CoulFMMTimeStepping::Settings
   try {
     opts->validate();
@@ -153,6 +167,13 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
     if (what.rfind("gcfmm: ", 0) == 0) what = what.substr(7);
     error->all(FLERR, "Fix coul/fmm {}", what);
   }
+  state = std::make_unique<CoulFMMState>(lmp, field_cols, groupbit);
+}
+
+CoulFMMScheme::Parts FixCoulFMM::parts()
+{
+  return {this, opts.get(), stepping.get(), state.get(), backend.get(), near.get(),
+          sleepers_static, distributed};
 }
 
 // the position of keyword arg[iarg]'s value among `words`, or an error listing them
@@ -172,9 +193,6 @@ FixCoulFMM::~FixCoulFMM()
   if (copymode) return;
   atom->delete_callback(id, Atom::GROW);
   atom->delete_callback(id, Atom::RESTART);
-  memory->destroy(field);
-  memory->destroy(eval_state);
-  memory->destroy(polar_force);
 }
 
 int FixCoulFMM::setmask()
@@ -190,73 +208,19 @@ void FixCoulFMM::init()
   if (domain->dimension != 3) error->all(FLERR, "Fix coul/fmm requires a 3d simulation");
   if (domain->triclinic) error->all(FLERR, "Fix coul/fmm does not support triclinic boxes");
   check_boundary_and_options();
-  evaluator->check_counted_once(this);
+  backend->check_counted_once(this);
   if (utils::strmatch(update->integrate_style, "^respa")) {
     ilevel_respa = (dynamic_cast<Respa *>(update->integrate))->nlevels - 1;
     if (respa_level >= 0) ilevel_respa = MIN(respa_level, ilevel_respa);
   }
-  auto sleep = modify->get_fix_by_style("^sleep/gran$");
-  if (polarizable) {
-    // doc/fix_coul_fmm.md, "Applied field, induced dipoles, electrode": every step, replicated
-    if (distributed)
-      error->all(FLERR, "Fix coul/fmm efield, polarize and electrode need solver replicated");
-    if (!sleep.empty() && sleepers_static)
-      error->all(FLERR,
-                 "Fix coul/fmm efield, polarize and electrode need sleepers full with fix "
-                 "sleep/gran (the static sleepers' field has no dipoles or images)");
-    // LAMMPS's fix efield pushes the charges only: with efield here it would count the field
-    // twice, with polarize it would leave the dipoles blind to it
-    if (!modify->get_fix_by_style("^efield").empty()) {
-      if (polarizable->settings().efield)
-        error->all(FLERR,
-                   "Fix coul/fmm efield and fix efield would both apply the field: use one");
-      if (polarizable->settings().polarize)
-        error->all(FLERR,
-                   "Fix coul/fmm polarize with fix efield: fix efield's field would not "
-                   "polarize the particles; give it to fix coul/fmm efield instead");
-    }
-    // the multiple time stepping of doc/polarization.md, section 8: the near pairs' change
-    // with the dipoles held, the far part extrapolated (or held), no keyword check
-    const auto &mts = stepping->settings();
-    if (mts.check_every > 0 && comm->me == 0)
-      error->warning(FLERR,
-                     "Fix coul/fmm {}: check is ignored with efield, polarize or electrode (the "
-                     "error of the time stepping is measured at every evaluation, vector element 9)",
-                     id);
-    const double half_cell = 0.5 * MIN(domain->xprd, domain->yprd);
-    if (opts->boundary == gcfmm::Boundary::Periodic2D && mts.every > 1 && mts.near_cutoff >= half_cell)
-      error->all(FLERR,
-                 "Fix coul/fmm near {:g} with efield, polarize or electrode must be smaller than "
-                 "half the periodic cell ({:g})",
-                 mts.near_cutoff, half_cell);
-    polarizable->init(*opts);
-    polarizable->set_time_stepping(mts.every > 1 ? mts.near_cutoff : 0.0, mts.every > 1,
-                                   mts.every > 1 && mts.extrapolate);
-    return;
-  }
-  evaluator->init(
-      *opts, sleep.empty() || !sleepers_static ? nullptr : dynamic_cast<FixSleepGran *>(sleep[0]),
-      thermo_virial, distributed);
-
-  const auto &mts = stepping->settings();
-  if (mts.tolerance > 0.0 && comm->me == 0)
-    utils::logmesg(lmp,
-                   "Fix coul/fmm {}: evaluation interval adapted between 1 and {} steps to "
-                   "a time-stepping error of {:.3g}\n",
-                   id, mts.every, mts.tolerance);
-  if (mts.near_cutoff > 0.0 && mts.every == 1 && comm->me == 0)
-    error->warning(FLERR,
-                   "Fix coul/fmm {}: near has no effect with every 1 (each step is an "
-                   "evaluation)",
-                   id);
-  if (stepping->refreshes_near()) near->request(mts.near_cutoff);
+  scheme->init();
 }
 
-// the boundary and the solver options the box allows (CoulFMMEvaluator::set_geometry), and
+// the boundary and the solver options the box allows (CoulFMMBackend::set_geometry), and
 // settings that are ignored or cost more than they save
 void FixCoulFMM::check_boundary_and_options()
 {
-  evaluator->set_geometry(*opts, bed_given);
+  backend->set_geometry(*opts, bed_given);
   const bool periodic = opts->boundary == gcfmm::Boundary::Periodic2D, me0 = comm->me == 0;
   if (!periodic && !periodic_keyword.empty() && me0)
     error->warning(FLERR,
@@ -287,11 +251,7 @@ void FixCoulFMM::init_list(int /*id*/, NeighList *ptr)
 
 void FixCoulFMM::setup(int vflag)
 {
-  // continue the schedule of the previous run (or of the restart file) when its stored field
-  // still belongs to these atoms, charges and box: a run split into pieces, or continued from
-  // a restart, then evaluates on the same steps as the uninterrupted run
-  // (with efield, polarize or electrode: an evaluation at every setup)
-  if (polarizable || !evaluator->continues(*stepping, eval_state)) stepping->restart_schedule();
+  if (!scheme->continues()) stepping->restart_schedule();
   if (utils::strmatch(update->integrate_style, "^verlet")) {
     post_force(vflag);
   } else {
@@ -309,7 +269,8 @@ void FixCoulFMM::post_force_respa(int vflag, int ilevel, int /*iloop*/)
 
 void FixCoulFMM::min_setup(int vflag)
 {
-  if (!polarizable && stepping->settings().every > 1 && comm->me == 0)
+  if (!dynamic_cast<CoulFMMPolarizable *>(scheme.get()) && stepping->settings().every > 1 &&
+      comm->me == 0)
     error->warning(FLERR,
                    "Fix coul/fmm {}: every {} is ignored during minimization (a minimizer "
                    "needs forces and energy of the current positions)",
@@ -317,147 +278,41 @@ void FixCoulFMM::min_setup(int vflag)
   min_post_force(vflag);
 }
 
-// a line search evaluates several trial positions within one step: always recompute
+// a line search evaluates several trial positions within one step: no prediction
 void FixCoulFMM::min_post_force(int vflag)
 {
-  v_init(vflag);
-  if (polarizable) {
-    post_force_polarizable(false);    // trial positions: no prediction from the last steps
-    return;
-  }
-  compute_field(false);
-  apply_field();
-  remember_positions();
+  apply(vflag, false);
 }
 
 void FixCoulFMM::post_force(int vflag)
 {
+  apply(vflag, true);
+}
+
+// the scheme's forces of this step to the atoms; energy 1/2 sum q_i phi_i (and the dipoles'
+// terms); virial sum x_i F_i (with x and y periodic only its zz term is the virial of the
+// lattice: image shifts have no z component); where the atoms were when the field was applied
+void FixCoulFMM::apply(int vflag, bool predict)
+{
   v_init(vflag);
-  if (polarizable) {
-    post_force_polarizable(true);
-    return;
-  }
-  const bigint step = update->ntimestep;
-  // evaluate on the schedule's steps, whenever atoms were added or removed (fix deposit,
-  // evaporate: a new atom must feel, and exert, the force from its first step) and whenever
-  // the charges, qqrd2e or the geometry changed (a stored field would belong to other charges)
-  const bool due = stepping->scheduled(step) ||
-      evaluator->continuity(*stepping, eval_state) != MTS::Continuity::SAME;
-  if (due)
-    compute_field(true);
-  else if (stepping->settings().every > 1)
-    advance_field();
-  const int check = stepping->settings().check_every;
-  if (check > 0 && !due && step % check == 0) evaluator->measure_error(*stepping, field);
-  apply_field();
-  remember_positions();
-}
-
-// where the atoms were when a field was last applied (a later run continues from there only)
-void FixCoulFMM::remember_positions()
-{
-  for (int i = 0; i < atom->nlocal; i++)
-    domain->unmap(atom->x[i], atom->image[i], &eval_state[i][MTS::LAST_X]);
-}
-
-// a full evaluation (doc/theory.md, eqs. (5.2)-(5.4)); with the same atoms as at the last one
-// it first measures the error the time stepping had reached (CoulFMMTimeStepping::plan)
-void FixCoulFMM::compute_field(bool with_slope)
-{
-  const int nlocal = atom->nlocal;
-  evaluator->update_sleepers();
-  const auto cont = with_slope && stepping->settings().every > 1
-      ? evaluator->continuity(*stepping, eval_state)
-      : MTS::Continuity::NONE;
-  const MTS::Plan plan = stepping->plan(cont, with_slope, update->ntimestep);
-  // the refresh the time stepping would have applied now, and D for a new slope
-  if (plan.near) {
-    near->compute(*stepping, eval_state, false,
-                  plan.keep_slope ? stepping->trend_factor(plan.steps) : 0.0);
-    if (plan.new_slope) near->compute(*stepping, eval_state, true, -1.0);
-  }
-  for (int i = 0; i < nlocal; i++) {
-    double xu[3];
-    domain->unmap(atom->x[i], atom->image[i], xu);
-    const double q = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
-    stepping->begin_evaluation(plan, eval_state[i], xu, q, evaluator->asleep(i),
-                               plan.near ? near->now()[i] : nullptr,
-                               plan.near ? near->then()[i] : nullptr, field[i]);
-  }
-  evaluator->record(*stepping, eval_state);
-  evaluator->evaluate(eval_state, MTS::FIELD, true);
-  nevaluations++;
-  double sums[2] = {0.0, 0.0};
-  for (int i = 0; i < nlocal; i++) {
-    stepping->end_evaluation(plan, eval_state[i], field[i], sums);
-    for (int k = 0; k < 4; k++) field[i][k] = eval_state[i][MTS::FIELD + k];
-  }
-  if (plan.same) mpi->sum(sums, 2);
-  stepping->finish_evaluation(plan, MTS::relative_rms(sums));
-}
-
-// eq. (5.2) between evaluations
-void FixCoulFMM::advance_field()
-{
-  const double steps = (double) (update->ntimestep - stepping->evaluated.step);
-  const bool refresh = stepping->settings().near_cutoff > 0.0;
-  if (refresh) near->compute(*stepping, eval_state, false, stepping->trend_factor(steps));
-  for (int i = 0; i < atom->nlocal; i++)
-    stepping->predict(eval_state[i], steps, refresh ? near->now()[i] : nullptr, field[i]);
-}
-
-// F_i = q_i E_i; energy 1/2 sum q_i phi_i; virial sum x_i F_i (with x and y periodic only its
-// zz term is the virial of the lattice: image shifts have no z component)
-void FixCoulFMM::apply_field()
-{
-  double *q = atom->q;
-  energy_local = 0.0;
+  energy_local = scheme->compute(predict);
   energy_summed = false;
   const bool in_plane = opts->boundary != gcfmm::Boundary::Periodic2D;
-  for (int i = 0; i < atom->nlocal; i++) {
-    if (!(atom->mask[i] & groupbit) || q[i] == 0.0) continue;
-    const double fi[3] = {q[i] * field[i][0], q[i] * field[i][1], q[i] * field[i][2]};
-    add_force(i, fi, in_plane);
-    energy_local += 0.5 * q[i] * field[i][3];
-  }
-}
-
-// the force on atom i, and its virial term (with x and y periodic only zz, see apply_field())
-void FixCoulFMM::add_force(int i, const double *fi, bool in_plane)
-{
   double **x = atom->x, **f = atom->f;
-  for (int k = 0; k < 3; k++) f[i][k] += fi[k];
-  if (!evflag) return;
-  double v[6] = {in_plane ? fi[0] * x[i][0] : 0.0,
-                 in_plane ? fi[1] * x[i][1] : 0.0,
-                 fi[2] * x[i][2],
-                 in_plane ? fi[1] * x[i][0] : 0.0,
-                 in_plane ? fi[2] * x[i][0] : 0.0,
-                 in_plane ? fi[2] * x[i][1] : 0.0};
-  v_tally(i, v);
-}
-
-// efield, polarize, electrode: F_i = q_i E_i + (p_i . grad) E_i and the energy of
-// doc/polarization.md, eq. (3.4), evaluated on the schedule's steps and continued between them
-// (section 8); a minimizer's call (predict false) always evaluates; virial as in apply_field()
-void FixCoulFMM::post_force_polarizable(bool predict)
-{
-  const bigint step = update->ntimestep;
-  const bool continued = predict && !stepping->scheduled(step) &&
-      polarizable->advance(field, polar_force, energy_local);
-  if (!continued) {
-    energy_local = polarizable->evaluate(field, polar_force, predict, stepping->stride());
-    nevaluations++;
-    if (predict) {
-      if (polarizable->prediction_error() >= 0.0) stepping->adapt(polarizable->prediction_error());
-      stepping->evaluated.step = step;
-    }
+  for (int i = 0; i < atom->nlocal; i++) {
+    if (!scheme->acts_on(i)) continue;
+    const double *fi = state->force_on(i);
+    for (int k = 0; k < 3; k++) f[i][k] += fi[k];
+    if (!evflag) continue;
+    double v[6] = {in_plane ? fi[0] * x[i][0] : 0.0,
+                   in_plane ? fi[1] * x[i][1] : 0.0,
+                   fi[2] * x[i][2],
+                   in_plane ? fi[1] * x[i][0] : 0.0,
+                   in_plane ? fi[2] * x[i][0] : 0.0,
+                   in_plane ? fi[2] * x[i][1] : 0.0};
+    v_tally(i, v);
   }
-  energy_summed = false;
-  const bool in_plane = opts->boundary != gcfmm::Boundary::Periodic2D;
-  for (int i = 0; i < atom->nlocal; i++)
-    if (atom->mask[i] & groupbit) add_force(i, polar_force[i], in_plane);
-  remember_positions();
+  state->remember_positions();
 }
 
 // with static sleepers, plus their pair energy with the awake charges and among themselves
@@ -465,11 +320,10 @@ double FixCoulFMM::compute_scalar()
 {
   if (!energy_summed) {
     energy_all = energy_local;
-    mpi->sum(&energy_all, 1);
+    backend->communication().sum(&energy_all, 1);
     energy_summed = true;
   }
-  if (!evaluator->split_active()) return energy_all;
-  return energy_all + evaluator->sleeper_pair_energy() + evaluator->sleeper_source_energy();
+  return scheme->total_energy(energy_all);
 }
 
 // doc/fix_coul_fmm.md, "Output": 1-4 solver (error estimate, order, M2L, P2P), 5-7 keyword
@@ -479,64 +333,54 @@ double FixCoulFMM::compute_scalar()
 // iterations and residual at the last evaluation (polarize)
 double FixCoulFMM::compute_vector(int n)
 {
-  const auto &d = evaluator->diagnostics_of_last();
-  const bool pol = polarizable != nullptr;
-  const double values[14] = {pol ? polarizable->estimated_error() : d.estimated_error,
-                             pol ? (double) polarizable->order() : (double) d.order,
-                             pol ? polarizable->m2l() : d.m2l,
-                             pol ? polarizable->p2p() : d.p2p,
+  const auto &d = scheme->diagnostics();
+  const double values[14] = {d.estimated_error,
+                             (double) d.order,
+                             d.m2l,
+                             d.p2p,
                              stepping->check_last(),
                              stepping->check_max(),
                              stepping->check_overall(),
                              (double) stepping->stride(),
                              stepping->last_estimate(),
-                             (double) nevaluations,
+                             scheme->evaluations(),
                              d.bytes_received,
                              d.solver_memory,
-                             polarizable ? (double) polarizable->iterations() : 0.0,
-                             polarizable ? polarizable->residual() : 0.0};
+                             (double) d.iterations,
+                             d.residual};
   return n >= 0 && n < 14 ? values[n] : 0.0;
 }
 
 double FixCoulFMM::memory_usage()
 {
-  return (field_cols + 3.0 + MTS::COLS) * atom->nmax * sizeof(double) + near->memory_usage() +
-      evaluator->memory_usage() + (polarizable ? polarizable->memory_usage() : 0.0);
+  return state->memory_usage() + near->memory_usage() + scheme->memory_usage();
 }
 
 void FixCoulFMM::grow_arrays(int nmax)
 {
-  memory->grow(field, nmax, field_cols, "coul/fmm:field");
-  memory->grow(polar_force, nmax, 3, "coul/fmm:polar_force");
-  memory->grow(eval_state, nmax, MTS::COLS, "coul/fmm:eval_state");
-  array_atom = field;
+  state->grow(nmax);
+  array_atom = state->field_rows();
 }
 
 void FixCoulFMM::copy_arrays(int i, int j, int /*delflag*/)
 {
-  for (int k = 0; k < field_cols; k++) field[j][k] = field[i][k];
-  for (int k = 0; k < MTS::COLS; k++) eval_state[j][k] = eval_state[i][k];
+  state->copy(i, j);
 }
 
-// a created atom has no stored field; its charge 0 in eval_state marks it as new
+// a created atom has no stored field; its charge 0 in the evaluation row marks it as new
 void FixCoulFMM::set_arrays(int i)
 {
-  for (int k = 0; k < field_cols; k++) field[i][k] = 0.0;
-  for (int k = 0; k < MTS::COLS; k++) eval_state[i][k] = 0.0;
+  state->clear(i);
 }
 
 int FixCoulFMM::pack_exchange(int i, double *buf)
 {
-  for (int k = 0; k < field_cols; k++) buf[k] = field[i][k];
-  for (int k = 0; k < MTS::COLS; k++) buf[field_cols + k] = eval_state[i][k];
-  return field_cols + MTS::COLS;
+  return state->pack_exchange(i, buf);
 }
 
 int FixCoulFMM::unpack_exchange(int nlocal, double *buf)
 {
-  for (int k = 0; k < field_cols; k++) field[nlocal][k] = buf[k];
-  for (int k = 0; k < MTS::COLS; k++) eval_state[nlocal][k] = buf[field_cols + k];
-  return field_cols + MTS::COLS;
+  return state->unpack_exchange(nlocal, buf);
 }
 
 int FixCoulFMM::pack_forward_comm(int n, int *list_send, double *buf, int /*pbc_flag*/,
@@ -570,10 +414,7 @@ void FixCoulFMM::restart(char *buf)
 
 int FixCoulFMM::pack_restart(int i, double *buf)
 {
-  buf[0] = 5 + MTS::COLS;    // count first, as atom->extra is shared by the fixes
-  for (int k = 0; k < 4; k++) buf[1 + k] = field[i][k];
-  for (int k = 0; k < MTS::COLS; k++) buf[5 + k] = eval_state[i][k];
-  return 5 + MTS::COLS;
+  return state->pack_restart(i, buf);
 }
 
 void FixCoulFMM::unpack_restart(int nlocal, int nth)
@@ -581,20 +422,15 @@ void FixCoulFMM::unpack_restart(int nlocal, int nth)
   double **extra = atom->extra;
   int m = 0;
   for (int i = 0; i < nth; i++) m += static_cast<int>(extra[nlocal][m]);
-  // files written before the ASLEEP column hold COLS_V1 columns: the rest start at zero
-  const int cols = MIN(MTS::COLS, MAX(MTS::COLS_V1, static_cast<int>(extra[nlocal][m]) - 5));
-  m++;
-  for (int k = 0; k < 4; k++) field[nlocal][k] = extra[nlocal][m++];
-  for (int k = 4; k < field_cols; k++) field[nlocal][k] = 0.0;
-  for (int k = 0; k < MTS::COLS; k++) eval_state[nlocal][k] = k < cols ? extra[nlocal][m++] : 0.0;
+  state->unpack_restart(nlocal, &extra[nlocal][m]);
 }
 
 int FixCoulFMM::size_restart(int /*nlocal*/)
 {
-  return 5 + MTS::COLS;
+  return CoulFMMState::restart_size();
 }
 
 int FixCoulFMM::maxsize_restart()
 {
-  return 5 + MTS::COLS;
+  return CoulFMMState::restart_size();
 }

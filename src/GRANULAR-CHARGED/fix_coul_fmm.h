@@ -18,6 +18,7 @@ FixStyle(coul/fmm,FixCoulFMM);
 
 #include "fix.h"
 
+#include "coul_fmm_scheme.h"
 #include "coul_fmm_time_stepping.h"
 
 #include <cstdint>
@@ -25,19 +26,14 @@ FixStyle(coul/fmm,FixCoulFMM);
 #include <string>
 #include <vector>
 
-namespace gcfmm {
-struct Options;
-}    // namespace gcfmm
-
 namespace LAMMPS_NS {
-class CoulFMMComm;
-class CoulFMMEvaluator;
-class CoulFMMPolarizable;
 
 // Coulomb forces between the charged atoms of a group by the FMM core library (src/fmm):
 // free space (boundary f f f) or periodic in x and y and open in z (boundary p p f). The fix is
-// the LAMMPS adapter (keywords, checks, per-atom arrays, restart); the time stepping is
-// CoulFMMTimeStepping, one evaluation CoulFMMEvaluator, the communication CoulFMMComm.
+// the LAMMPS adapter (keywords, checks, per-atom callbacks, restart) over one solver backend
+// (CoulFMMBackend: box, units, errors), one scheme that computes the forces of a step
+// (CoulFMMChargeScheme, or CoulFMMPolarizable with efield, polarize or electrode) and one
+// owner of the per-atom state (CoulFMMState).
 class FixCoulFMM : public Fix {
  public:
   FixCoulFMM(class LAMMPS *, int, char **);
@@ -69,41 +65,28 @@ class FixCoulFMM : public Fix {
   int maxsize_restart() override;
 
  private:
-  std::unique_ptr<gcfmm::Options> opts;           // solver options from the keywords
-  std::unique_ptr<CoulFMMTimeStepping> stepping;  // the schedule and extrapolation
-  std::unique_ptr<CoulFMMEvaluator> evaluator;    // atoms -> solver -> field
-  std::unique_ptr<CoulFMMComm> mpi;
-  std::unique_ptr<class CoulFMMNearRefresh> near;    // the near refresh's list and buffers
-  // keywords efield, polarize, electrode: gcfmm::PolarizableSolver on the schedule's steps, continued
-  // in between (null if none)
-  std::unique_ptr<CoulFMMPolarizable> polarizable;
+  std::unique_ptr<gcfmm::Options> opts;              // solver options from the keywords
+  std::unique_ptr<CoulFMMTimeStepping> stepping;     // the schedule and extrapolation
+  std::unique_ptr<CoulFMMBackend> backend;           // the solver
+  std::unique_ptr<CoulFMMNearRefresh> near;          // the near refresh's list and buffers
+  std::unique_ptr<CoulFMMState> state;               // per-atom fields, forces, evaluation rows
+  std::unique_ptr<CoulFMMScheme> scheme;             // the forces of one step
   int field_cols;                  // per-atom columns: 4, or 7 with the dipole
-  double **polar_force;            // per atom: q E + (p . grad) E of the last evaluation
   bool bed_given;                  // bed zlo/zhi given by the user (farfield average)
   std::string periodic_keyword;    // last of images/farfield given (ignored in free space)
   bool sleepers_static;            // keyword sleepers: static (true) or full
   bool distributed;                // keyword solver: distributed (true) or replicated
 
-  bigint nevaluations;             // evaluations so far (diagnostic)
-
   double energy_local, energy_all;
   bool energy_summed;
   int ilevel_respa;    // rRESPA level at which the Coulomb force is applied (outermost)
 
-  // per atom: Ex, Ey, Ez, potential (force/charge, energy/charge), the field applied
-  double **field;
-  // per atom: the state of the last evaluation (CoulFMMTimeStepping::Column)
-  double **eval_state;
-
   void parse_keywords(int narg, char **arg);
+  void create_parts(const CoulFMMTimeStepping::Settings &mts);
+  CoulFMMScheme::Parts parts();
   int one_of(int iarg, const std::vector<std::string> &words, char **arg);
   void check_boundary_and_options();
-  void compute_field(bool with_slope);
-  void advance_field();
-  void apply_field();
-  void remember_positions();
-  void post_force_polarizable(bool predict);
-  void add_force(int i, const double *fi, bool in_plane);
+  void apply(int vflag, bool predict);
 };
 
 }    // namespace LAMMPS_NS

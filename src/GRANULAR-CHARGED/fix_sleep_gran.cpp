@@ -9,17 +9,18 @@
 
 #include "fix_sleep_gran.h"
 
-#include "pair_granular_opt.h"
-
 #include "atom.h"
 #include "comm.h"
 #include "domain.h"
 #include "error.h"
+#include "fix_neigh_history.h"
 #include "force.h"
 #include "group.h"
 #include "memory.h"
 #include "modify.h"
+#include "neigh_list.h"
 #include "neighbor.h"
+#include "pair.h"
 #include "update.h"
 
 #include <cmath>
@@ -31,7 +32,7 @@ using namespace FixConst;
 
 namespace {
 // what pack_forward_comm() and pack_reverse_comm() move
-enum CommMode { COMM_FLAGS, COMM_PUSH, COMM_WAKE };
+enum CommMode { COMM_FLAGS, COMM_PUSHED, COMM_PUSH, COMM_WAKE };
 // slots of the global restart list
 enum RestartSlot { R_SLEEP_EVENTS, R_WAKE_EVENTS, R_NSLOTS };
 }    // namespace
@@ -40,9 +41,10 @@ enum RestartSlot { R_SLEEP_EVENTS, R_WAKE_EVENTS, R_NSLOTS };
 
 FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), speed_sleep(-1.0), force_sleep(-1.0), force_wake(-1.0), rest_time(-1.0),
-    depth(0.0), every(100), rest_steps_needed(0), rest_rule(true), asleep(nullptr),
+    depth(0.0), every(100), rest_steps_needed(0), rest_rule(true), asleep(nullptr), pushed(nullptr),
     rest_steps(nullptr), push(nullptr), wake_mark(nullptr), ncontact(nullptr), comm_mode(COMM_FLAGS),
-    set_generation(0), nsleeping_all(0), nsleep_events(0), nwake_events(0), pair_checked(0)
+    set_generation(0), nsleeping_all(0), nsleep_events(0), nwake_events(0), pair_bookkeeping(false),
+    pair_history(nullptr)
 {
   if (!(atom->radius_flag && atom->rmass_flag && atom->omega_flag && atom->torque_flag))
     error->all(FLERR, "Fix {} requires atom attributes radius, rmass, omega and torque (atom_style sphere)", style);
@@ -109,7 +111,7 @@ FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
   atom->add_callback(Atom::GROW);
   atom->add_callback(Atom::RESTART);
   for (int i = 0; i < atom->nmax; i++) {
-    asleep[i] = rest_steps[i] = wake_mark[i] = ncontact[i] = 0.0;
+    asleep[i] = pushed[i] = rest_steps[i] = wake_mark[i] = ncontact[i] = 0.0;
     push[i][0] = push[i][1] = push[i][2] = 0.0;
   }
 }
@@ -122,6 +124,7 @@ FixSleepGran::~FixSleepGran()
   atom->delete_callback(id, Atom::GROW);
   atom->delete_callback(id, Atom::RESTART);
   memory->destroy(asleep);
+  memory->destroy(pushed);
   memory->destroy(rest_steps);
   memory->destroy(push);
   memory->destroy(wake_mark);
@@ -139,11 +142,16 @@ int FixSleepGran::setmask()
 
 void FixSleepGran::init()
 {
-  if (!force->pair_match("^granular/opt", 0))
-    error->all(FLERR,
-               "Fix {} requires pair_style granular/opt (the same physics as granular: use "
-               "-sf opt or 'pair_style granular/opt'), not {}",
-               style, force->pair_style ? force->pair_style : "none");
+  if (!force->pair_match("^granular", 0) || !force->pair->single_enable)
+    error->all(FLERR, "Fix {} requires pair_style granular or granular/opt, not {}", style,
+               force->pair_style ? force->pair_style : "none");
+  int dim = 0;
+  pair_bookkeeping = force->pair->extract("sleep/gran:bookkeeping", dim) != nullptr;
+  // the pair style's contact flags, if its models keep a history (fix neigh/history)
+  auto histories = modify->get_fix_by_style("^NEIGH_HISTORY$");
+  if (histories.size() > 1)
+    error->all(FLERR, "Fix {} needs a single granular pair style with one contact history", style);
+  pair_history = histories.empty() ? nullptr : dynamic_cast<FixNeighHistory *>(histories.front());
   for (auto *f : modify->get_fix_list()) {
     if (f->rigid_flag) error->all(FLERR, "Fix {} cannot be used with the rigid-body fix {}", style, f->id);
     if (utils::strmatch(f->style, "^deposit") || utils::strmatch(f->style, "^pour"))
@@ -225,12 +233,12 @@ void FixSleepGran::exchange_flags()
 
 void FixSleepGran::post_force(int /*vflag*/)
 {
+  if (!pair_bookkeeping) sum_contacts_and_push();
   if (force->newton_pair) {
     comm_mode = COMM_PUSH;
     comm->reverse_comm(this, 4);
   }
   const int nlocal = atom->nlocal;
-  int changed = 0;
 
   wake_pushed();
 
@@ -247,13 +255,69 @@ void FixSleepGran::post_force(int /*vflag*/)
   // falling asleep happens only on commit steps (fall_asleep() sums its count over the ranks)
   const bigint before = nsleep_events;
   if (update->ntimestep % every == 0) fall_asleep();
-  changed = nsleep_events != before;
-  if (changed) {
+  if (nsleep_events != before) {
     exchange_flags();
     set_generation++;
     count_sleeping();
   }
   hold_sleepers();
+}
+
+/* ----------------------------------------------------------------------
+   with a pair style that does not do the sleepers' bookkeeping: the contacts of this step
+   (touching pairs but those of two sleepers) and, for each sleeper, the contact forces of its
+   awake partners, recomputed by the pair's single() from the pair's neighbor list
+------------------------------------------------------------------------- */
+
+void FixSleepGran::sum_contacts_and_push()
+{
+  Pair *pair = force->pair;
+  NeighList *list = pair->list;
+  if (!list) return;
+  double **x = atom->x;
+  int *type = atom->type;
+  const int nlocal = atom->nlocal;
+  const int newton_pair = force->newton_pair;
+  double *special_lj = force->special_lj;
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    const int *jlist = list->firstneigh[i];
+    const int *touch = pair_history ? pair_history->firstflag[i] : nullptr;
+    for (int jj = 0; jj < list->numneigh[i]; jj++) {
+      const double factor_lj = special_lj[(jlist[jj] >> SBBITS) & 3];
+      const int j = jlist[jj] & NEIGHMASK;
+      if (factor_lj == 0.0 || (asleep[i] != 0.0 && asleep[j] != 0.0)) continue;
+      if (!touching(i, j, jj, touch)) continue;
+      const bool j_here = newton_pair || j < nlocal;
+      ncontact[i] += 1.0;
+      if (j_here) ncontact[j] += 1.0;
+      if (asleep[i] == 0.0 && asleep[j] == 0.0) continue;
+      double dx[3] = {x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]};
+      const double rsq = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
+      double fpair = 0.0;
+      pair->single(i, j, type[i], type[j], rsq, 1.0, factor_lj, fpair);
+      // the force on i: normal (fpair along dx) plus the sliding force svector[0..2]
+      for (int k = 0; k < 3; k++) {
+        const double fk = factor_lj * (fpair * dx[k] + pair->svector[k]);
+        if (asleep[i] != 0.0) push[i][k] += fk;
+        if (asleep[j] != 0.0 && j_here) push[j][k] -= fk;
+      }
+    }
+  }
+}
+
+/* ----------------------------------------------------------------------
+   pair i, j (entry jj of i's list) in contact: the pair style's contact flag when its models
+   keep a history, else overlap
+------------------------------------------------------------------------- */
+
+bool FixSleepGran::touching(int i, int j, int jj, const int *touch) const
+{
+  if (touch) return touch[jj] != 0;
+  double **x = atom->x;
+  const double dx = x[i][0] - x[j][0], dy = x[i][1] - x[j][1], dz = x[i][2] - x[j][2];
+  const double radsum = atom->radius[i] + atom->radius[j];
+  return dx * dx + dy * dy + dz * dz < radsum * radsum;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -280,12 +344,12 @@ void FixSleepGran::wake_pushed()
   const int nall = nlocal + atom->nghost;
   const double fw2 = force_wake * force_wake;
   int woken = 0;
-  for (int i = 0; i < nall; i++) wake_mark[i] = 0.0;    // also read by post_force()
+  for (int i = 0; i < nall; i++) wake_mark[i] = pushed[i] = 0.0;    // also read by post_force()
   for (int i = 0; i < nlocal; i++) {
     if (asleep[i] == 0.0) continue;
     const double *p = push[i];
     if (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] > fw2) {
-      wake_mark[i] = 1.0;
+      wake_mark[i] = pushed[i] = 1.0;
       woken++;
     }
   }
@@ -293,13 +357,11 @@ void FixSleepGran::wake_pushed()
   MPI_Allreduce(&woken, &any, 1, MPI_INT, MPI_MAX, world);
   if (!any) return;
 
-  // the pushed atoms are flagged -1 for one exchange, so that the pair style can mark the
-  // sleepers (1) touching them, local or ghost; ghost marks go to their owners
-  for (int i = 0; i < nlocal; i++)
-    if (wake_mark[i] != 0.0) asleep[i] = -1.0;
-  exchange_flags();
-  auto *pair = dynamic_cast<PairGranularOpt *>(force->pair_match("^granular/opt", 0));
-  if (pair) pair->mark_touching_sleepers(asleep, wake_mark);
+  // the ghosts learn which sleepers were pushed; the sleepers touching them, local or ghost,
+  // are marked, and ghost marks go to their owners
+  comm_mode = COMM_PUSHED;
+  comm->forward_comm(this);
+  mark_touching_sleepers();
   comm_mode = COMM_WAKE;
   comm->reverse_comm(this, 1);
 
@@ -316,6 +378,30 @@ void FixSleepGran::wake_pushed()
   exchange_flags();
   set_generation++;
   count_sleeping();
+}
+
+/* ----------------------------------------------------------------------
+   wake_mark[j] = 1 for every sleeper j touching a pushed sleeper (local and ghost atoms of the
+   pair style's list)
+------------------------------------------------------------------------- */
+
+void FixSleepGran::mark_touching_sleepers()
+{
+  NeighList *list = force->pair->list;
+  if (!list) return;
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    const int *jlist = list->firstneigh[i];
+    const int *touch = pair_history ? pair_history->firstflag[i] : nullptr;
+    for (int jj = 0; jj < list->numneigh[i]; jj++) {
+      const int j = jlist[jj] & NEIGHMASK;
+      const bool i_pushes_j = pushed[i] != 0.0 && asleep[j] != 0.0 && pushed[j] == 0.0;
+      const bool j_pushes_i = pushed[j] != 0.0 && asleep[i] != 0.0 && pushed[i] == 0.0;
+      if (!(i_pushes_j || j_pushes_i) || !touching(i, j, jj, touch)) continue;
+      if (j_pushes_i) wake_mark[i] = 1.0;
+      if (i_pushes_j) wake_mark[j] = 1.0;
+    }
+  }
 }
 
 /* ----------------------------------------------------------------------
@@ -424,9 +510,18 @@ void FixSleepGran::count_sleeping()
 
 /* ---------------------------------------------------------------------- */
 
+bigint FixSleepGran::awake_count() const
+{
+  return atom->natoms - nsleeping_all;
+}
+
+/* ----------------------------------------------------------------------
+   the scalar is the awake count (the atoms still integrated), the same as vector element 1
+------------------------------------------------------------------------- */
+
 double FixSleepGran::compute_scalar()
 {
-  return static_cast<double>(atom->natoms - nsleeping_all);
+  return static_cast<double>(awake_count());
 }
 
 /* ----------------------------------------------------------------------
@@ -436,7 +531,7 @@ double FixSleepGran::compute_scalar()
 
 double FixSleepGran::compute_vector(int n)
 {
-  if (n == 0) return static_cast<double>(atom->natoms - nsleeping_all);
+  if (n == 0) return static_cast<double>(awake_count());
   if (n == 1) return static_cast<double>(nsleeping_all);
   if (n == 2) return static_cast<double>(nsleep_events);
   return static_cast<double>(nwake_events);
@@ -444,9 +539,32 @@ double FixSleepGran::compute_vector(int n)
 
 /* ---------------------------------------------------------------------- */
 
+void *FixSleepGran::extract(const char *name, int &dim)
+{
+  if (strcmp(name, "sleeping") == 0) {
+    dim = 1;
+    return asleep;
+  }
+  if (strcmp(name, "generation") == 0) {
+    dim = 0;
+    return &set_generation;
+  }
+  if (strcmp(name, "push") == 0) {
+    dim = 2;
+    return push;
+  }
+  if (strcmp(name, "contacts") == 0) {
+    dim = 1;
+    return ncontact;
+  }
+  return nullptr;
+}
+
+/* ---------------------------------------------------------------------- */
+
 double FixSleepGran::memory_usage()
 {
-  return static_cast<double>(atom->nmax) * 7 * sizeof(double);
+  return static_cast<double>(atom->nmax) * 8 * sizeof(double);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -454,6 +572,7 @@ double FixSleepGran::memory_usage()
 void FixSleepGran::grow_arrays(int nmax)
 {
   memory->grow(asleep, nmax, "sleep/gran:asleep");
+  memory->grow(pushed, nmax, "sleep/gran:pushed");
   memory->grow(rest_steps, nmax, "sleep/gran:rest_steps");
   memory->grow(push, nmax, 3, "sleep/gran:push");
   memory->grow(wake_mark, nmax, "sleep/gran:wake_mark");
@@ -490,13 +609,15 @@ int FixSleepGran::unpack_exchange(int nlocal, double *buf)
 
 int FixSleepGran::pack_forward_comm(int n, int *list, double *buf, int /*pbc_flag*/, int * /*pbc*/)
 {
-  for (int k = 0; k < n; k++) buf[k] = asleep[list[k]];
+  const double *flags = comm_mode == COMM_PUSHED ? pushed : asleep;
+  for (int k = 0; k < n; k++) buf[k] = flags[list[k]];
   return n;
 }
 
 void FixSleepGran::unpack_forward_comm(int n, int first, double *buf)
 {
-  for (int k = 0; k < n; k++) asleep[first + k] = buf[k];
+  double *flags = comm_mode == COMM_PUSHED ? pushed : asleep;
+  for (int k = 0; k < n; k++) flags[first + k] = buf[k];
 }
 
 int FixSleepGran::pack_reverse_comm(int n, int first, double *buf)
@@ -526,7 +647,8 @@ void FixSleepGran::unpack_reverse_comm(int n, int *list, double *buf)
       push[j][2] += buf[m++];
       ncontact[j] += buf[m++];
     } else {
-      wake_mark[j] = MAX(wake_mark[j], buf[m++]);
+      const double mark = buf[m++];    // read once: MAX() would evaluate it twice
+      if (mark > wake_mark[j]) wake_mark[j] = mark;
     }
   }
 }

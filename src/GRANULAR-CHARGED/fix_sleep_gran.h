@@ -25,11 +25,16 @@ namespace LAMMPS_NS {
 // Sleeping particles for granular beds (doc/fix_sleep_gran.md): a particle of the group that has
 // been at rest (speed, surface spin speed and net force below thresholds) for a stated time, and
 // optionally lies deep enough below the local bed surface, sleeps: velocity, spin, force and
-// torque are held at zero, so the integrator leaves it in place, and pair_style granular/opt
-// skips the contacts between two sleepers (their history is kept). Contacts of an awake particle
-// with a sleeper are computed as usual: the sleeper is a fixed body of its own shape. A sleeper
-// wakes, with the sleepers touching it, when the contact force from its awake partners exceeds
-// the wake threshold. Falling asleep is committed every `every` steps, waking on the step.
+// torque are held at zero, so the integrator leaves it in place. A sleeper wakes, with the
+// sleepers touching it, when the contact force from its awake partners exceeds the wake
+// threshold. Falling asleep is committed every `every` steps, waking on the step.
+//
+// The state is published through extract() (names below), so that no pair style includes this
+// header and this fix includes no pair style's: a pair style that does the sleepers' bookkeeping
+// itself (pair_style granular/opt: sleeper pairs skipped, a sleeper a fixed body, the push and
+// contact counts summed in its loop) says so by its own extract("sleep/gran:bookkeeping"); with
+// any other granular pair style (pair_style granular) the fix counts the contacts and sums the
+// push itself from the pair's neighbor list, contact flags and single().
 class FixSleepGran : public Fix {
  public:
   FixSleepGran(class LAMMPS *, int, char **);
@@ -60,18 +65,15 @@ class FixSleepGran : public Fix {
   int size_restart(int) override;
   int maxsize_restart() override;
 
-  // for pair_style granular/opt and fix coul/fmm: 1.0 for a sleeping atom (local and ghost
-  // atoms; ghosts are current from pre_force() on), 0.0 awake
-  const double *sleeping() const { return asleep; }
-  // changes whenever the sleeping set may have changed on any rank (the same on all ranks)
-  bigint generation() const { return set_generation; }
-  // per atom (local and ghost): contact force on a sleeper from its awake partners, summed
-  // by the pair style into this array (zeroed in pre_force)
-  double **awake_push() { return push; }
-  // per atom (local and ghost): contacts the pair style computed this step (zeroed in
-  // pre_force); only an atom that touches another can fall asleep
-  double *contact_count() { return ncontact; }
-  bigint sleeping_count() const { return nsleeping_all; }
+  // "sleeping" (dim 1): 1.0 for a sleeping atom, 0.0 awake (local and ghost atoms; ghosts are
+  //   current from pre_force() on)
+  // "generation" (dim 0, bigint): changes whenever the sleeping set may have changed on any rank
+  //   (the same on all ranks)
+  // "push" (dim 2): per atom (local and ghost), the contact force on a sleeper from its awake
+  //   partners (zeroed in pre_force, summed by the pair style or by this fix)
+  // "contacts" (dim 1): per atom (local and ghost), contacts computed this step (zeroed in
+  //   pre_force); only an atom that touches another can fall asleep
+  void *extract(const char *, int &) override;
 
  private:
   double speed_sleep, force_sleep, force_wake, rest_time, depth;
@@ -79,6 +81,7 @@ class FixSleepGran : public Fix {
   bool rest_rule;    // time none: only the depth rule
 
   double *asleep;        // 1.0 sleeping, 0.0 awake (local + ghost)
+  double *pushed;        // 1.0 for a sleeper pushed beyond wake on this step (local + ghost)
   double *rest_steps;    // consecutive steps at rest (local)
   double **push;         // force from awake contact partners (local + ghost)
   double *wake_mark;     // reverse-communicated wake requests (local + ghost)
@@ -87,9 +90,14 @@ class FixSleepGran : public Fix {
 
   bigint set_generation;
   bigint nsleeping_all, nsleep_events, nwake_events;
-  int pair_checked;
+  bool pair_bookkeeping;    // the pair style sums push and contacts itself
+  class FixNeighHistory *pair_history;    // the pair style's contact flags (null: none)
 
   void exchange_flags();
+  void sum_contacts_and_push();
+  void mark_touching_sleepers();
+  bool touching(int i, int j, int jj, const int *touch) const;
+  bigint awake_count() const;
   bool at_rest(int i) const;
   void fall_asleep();
   void wake_pushed();

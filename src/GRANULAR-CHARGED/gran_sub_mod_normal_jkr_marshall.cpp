@@ -9,12 +9,12 @@
 
 #include "gran_sub_mod_normal_jkr_marshall.h"
 
-#include "gran_sub_mod_damping_marshall.h"
-
 #include "citeme.h"
 #include "error.h"
+#include "gran_sub_mod.h"
 #include "granular_model.h"
 #include "math_const.h"
+#include "utils.h"
 
 #include <cmath>
 
@@ -38,7 +38,7 @@ static const char cite_jkr_marshall[] =
 /* ---------------------------------------------------------------------- */
 
 GranSubModNormalJKRMarshall::GranSubModNormalJKRMarshall(GranularModel *gm, LAMMPS *lmp) :
-    GranSubModNormalJKR(gm, lmp), restitution(0.0), Gmix(0.0), contact()
+    GranSubModNormalJKR(gm, lmp), restitution(0.0), Gmix(0.0), contact(), scales(), scales_reff(-1.0)
 {
   if (lmp->citeme) lmp->citeme->add(cite_jkr_marshall);
 }
@@ -54,7 +54,7 @@ void GranSubModNormalJKRMarshall::coeffs_to_local()
   poiss = coeffs[2];          // Poisson's ratio
   cohesion = coeffs[3];       // surface energy gamma per surface (work of adhesion 2 gamma)
   damp = restitution;         // what damping models read through get_damp()
-  scales = JKRScales();       // the scales depend on the coefficients: recompute them
+  scales_reff = -1.0;         // the scales depend on the coefficients: recompute them
 
   if (!(Emod > 0.0))
     error->all(FLERR, "Illegal jkr/marshall normal model, Young's modulus must be > 0, got {}",
@@ -109,11 +109,13 @@ void GranSubModNormalJKRMarshall::mix_coeffs(double *icoeffs, double *jcoeffs)
 
 void GranSubModNormalJKRMarshall::init()
 {
-  if (!dynamic_cast<GranSubModDampingMarshall *>(gm->damping_model))
+  // by name (damping marshall and marshall/printed), so that the normal model does not depend
+  // on the damping model's class
+  if (!utils::strmatch(gm->sub_models[DAMPING]->name, "^marshall"))
     error->all(FLERR,
                "Normal model jkr/marshall requires damping marshall (its second coefficient is "
                "the restitution coefficient that only damping marshall uses), got damping {}",
-               gm->damping_model->name);
+               gm->sub_models[DAMPING]->name);
 }
 
 /* ----------------------------------------------------------------------
@@ -123,8 +125,15 @@ void GranSubModNormalJKRMarshall::init()
 bool GranSubModNormalJKRMarshall::touch()
 {
   // delta_C matters only to a contact that exists: a new one forms at delta >= 0
-  if (gm->touch) use_jkr_scales(scales, gm->Reff, cohesion, Emix);
+  if (gm->touch) use_scales(gm->Reff);
   return jkr_touch(gm->touch, gm->rsq, gm->radsum, scales.deltac);
+}
+
+void GranSubModNormalJKRMarshall::use_scales(double reff)
+{
+  if (reff == scales_reff) return;
+  scales_reff = reff;
+  scales = jkr_scales(reff, cohesion, Emix);
 }
 
 /* ----------------------------------------------------------------------
@@ -147,7 +156,7 @@ double GranSubModNormalJKRMarshall::pulloff_distance(double radi, double radj)
 
 double GranSubModNormalJKRMarshall::calculate_contact_radius()
 {
-  use_jkr_scales(scales, gm->Reff, cohesion, Emix);
+  use_scales(gm->Reff);
   contact = jkr_normal_force(scales, cohesion, Emix, gm->delta, gm->Reff);
   return contact.a;
 }

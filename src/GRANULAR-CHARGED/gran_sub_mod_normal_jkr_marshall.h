@@ -51,7 +51,11 @@ namespace Granular_NS {
     // the current contact: computed with its contact radius, read by calculate_forces() and by
     // rolling marshall (LAMMPS asks for the radius first, then for the force)
     MarshallKernels::NormalForce contact;
-    MarshallKernels::JKRScales scales;    // delta_C, a_sep, F_C of the last R seen
+    // delta_C, a_sep, F_C of radius scales_reff: LAMMPS hands the sub-model one contact at a
+    // time, and most contacts of a packing share their R, so the scales are kept until R changes
+    MarshallKernels::JKRScales scales;
+    double scales_reff;
+    void use_scales(double reff);
   };
 
 }    // namespace Granular_NS

@@ -12,8 +12,8 @@
 // GCC vectorises the guarded square root only without errno and traps.
 #include "jkr_scaled.h"
 
-#include "gcfmm/simd.hpp"
-#include "gcfmm/simd_paths.hpp"
+#include "gcsimd/simd.hpp"
+#include "gcsimd/simd_paths.hpp"
 
 #include <array>
 #include <cmath>
@@ -28,13 +28,13 @@ constexpr int N_INTERVALS = 1024;
 constexpr double U_MAX = 16.0;
 constexpr double H = U_MAX / N_INTERVALS;
 
-GCFMM_ALWAYS_INLINE double residual(double s, double Delta)
+GCSIMD_ALWAYS_INLINE double residual(double s, double Delta)
 {
   return s * (s * s * s - 4.0) - 3.0 * Delta;
 }
 
 // one Newton step on g(s) = s^4 - 4 s - 3 Delta; g' = 4 (s^3 - 1) > 0 for s > 1
-GCFMM_ALWAYS_INLINE double newton_step(double s, double Delta)
+GCSIMD_ALWAYS_INLINE double newton_step(double s, double Delta)
 {
   const double slope = 4.0 * (s * s * s - 1.0);
   return slope > 0.0 ? s - residual(s, Delta) / slope : s;
@@ -63,7 +63,7 @@ const std::array<Node, N_INTERVALS + 2> &table()
 
 // Cubic Hermite interpolation in u on the table, then one Newton step (root(), below, says why
 // that is accurate); u < U_MAX
-GCFMM_ALWAYS_INLINE double table_root(const Node *t, double u, double Delta)
+GCSIMD_ALWAYS_INLINE double table_root(const Node *t, double u, double Delta)
 {
   const double x = u * (1.0 / H);
   const long i = static_cast<long>(x);    // long: GCC vectorises the gather with 64-bit indices
@@ -79,7 +79,7 @@ GCFMM_ALWAYS_INLINE double table_root(const Node *t, double u, double Delta)
 
 // root()'s table branch for every element (one outside the table, u >= U_MAX, is computed at
 // u = 0 here and replaced by the caller)
-GCFMM_ALWAYS_INLINE void roots_loop(std::size_t n, const double *__restrict Delta,
+GCSIMD_ALWAYS_INLINE void roots_loop(std::size_t n, const double *__restrict Delta,
                                     double *__restrict out, const Node *__restrict t)
 {
 #pragma omp simd
@@ -94,7 +94,7 @@ GCFMM_ALWAYS_INLINE void roots_loop(std::size_t n, const double *__restrict Delt
 
 #define GC_ROOTS_PARAMS (std::size_t n, const double *Delta, double *out, const Node *t)
 #define GC_ROOTS_ARGS (n, Delta, out, t)
-GCFMM_DEFINE_SIMD_PATHS(void, roots_kernel, GC_ROOTS_PARAMS, roots_loop, GC_ROOTS_ARGS)
+GCSIMD_DEFINE_PATHS(void, roots_kernel, GC_ROOTS_PARAMS, roots_loop, GC_ROOTS_ARGS)
 
 }    // namespace
 
@@ -140,9 +140,9 @@ double root(double Delta)
   return s;
 }
 
-void roots(std::size_t n, const double *Delta, double *s, gcfmm::SimdPath path)
+void roots(std::size_t n, const double *Delta, double *s, gcsimd::SimdPath path)
 {
-  if (!gcfmm::simd_path_available(path)) path = gcfmm::SimdPath::Generic;
+  if (!gcsimd::simd_path_available(path)) path = gcsimd::SimdPath::Generic;
   roots_kernel_for(path)(n, Delta, s, table().data());
   // beyond the table (Delta >= U_MAX^2 - 1 = 255; from 254, clear of sqrt's rounding): root()
   for (std::size_t k = 0; k < n; ++k)
@@ -151,7 +151,7 @@ void roots(std::size_t n, const double *Delta, double *s, gcfmm::SimdPath path)
 
 void roots(std::size_t n, const double *Delta, double *s)
 {
-  static const gcfmm::SimdPath path = gcfmm::default_simd_path();
+  static const gcsimd::SimdPath path = gcsimd::default_simd_path();
   roots(n, Delta, s, path);
 }
 

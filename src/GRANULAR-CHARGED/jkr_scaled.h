@@ -19,8 +19,8 @@
 
 #include <cstddef>
 
-namespace gcfmm {
-enum class SimdPath;    // gcfmm/simd.hpp: the instruction-set paths of the batched root
+namespace gcsimd {
+enum class SimdPath;    // gcsimd/simd.hpp: the instruction-set paths of the batched root
 }
 
 namespace LAMMPS_NS {
@@ -36,7 +36,7 @@ namespace JKRScaled {
   // dependent operations (sqrt, table load, Newton division) that a vector of them hides.
   void roots(std::size_t n, const double *Delta, double *s);
   // the same on a given path (tests and benchmarks; an unavailable path falls back to generic)
-  void roots(std::size_t n, const double *Delta, double *s, gcfmm::SimdPath path);
+  void roots(std::size_t n, const double *Delta, double *s, gcsimd::SimdPath path);
 
   // The same root by bisection (slow; for the table and for tests).
   double root_by_bisection(double Delta);

@@ -46,7 +46,6 @@ namespace MarshallKernels {
   }
 
   struct JKRScales {
-    double reff = -1.0;          // R these scales belong to (-1: none yet)
     double deltac = 0.0;         // delta_C
     double inv_deltac = 0.0;     // 1 / delta_C (0 without adhesion)
     double asep = 0.0;           // contact radius at separation, a_0 / 6^(2/3)
@@ -54,17 +53,23 @@ namespace MarshallKernels {
     double sqrt_kn_sep = 0.0;    // sqrt(4/3 E* a_sep): sqrt(k_N) = s sqrt_kn_sep, as a = a_sep s^2
   };
 
-  // delta_C, a_sep = (pi gamma R^2 / (4 E*))^(1/3) and F_C for radius R, recomputed only when R
-  // changes (a monodisperse packing has one R per type pair: one cbrt per run, not per contact)
-  inline void use_jkr_scales(JKRScales &sc, double reff, double gamma, double emix)
+  // delta_C, a_sep = (pi gamma R^2 / (4 E*))^(1/3) and F_C for radius R (two cube roots: a
+  // caller with one R for many contacts computes them once, outside its loop)
+  inline JKRScales jkr_scales(double reff, double gamma, double emix)
   {
-    if (reff == sc.reff) return;
-    sc.reff = reff;
+    JKRScales sc;
     sc.deltac = critical_overlap(reff, gamma, emix);
     sc.inv_deltac = (sc.deltac > 0.0) ? 1.0 / sc.deltac : 0.0;
     sc.asep = cbrt(MathConst::MY_PI * gamma * reff * reff / (4.0 * emix));
     sc.fc = 3.0 * MathConst::MY_PI * gamma * reff;
     sc.sqrt_kn_sep = sqrt(4.0 / 3.0 * emix * sc.asep);
+    return sc;
+  }
+
+  // R_eff = R_i R_j / (R_i + R_j)
+  inline double effective_radius(double radi, double radj)
+  {
+    return radi * radj / (radi + radj);
   }
 
   // contact life (Marshall 2009): forms at delta >= 0, persists in tension to delta = -delta_C

@@ -9,8 +9,6 @@
 
 #include "pair_granular_opt.h"
 
-#include "fix_sleep_gran.h"
-
 #include "gran_sub_mod_damping_marshall.h"
 #include "gran_sub_mod_normal_jkr_marshall.h"
 #include "gran_sub_mod_rolling_marshall.h"
@@ -33,6 +31,7 @@
 #include "update.h"
 
 #include <cmath>
+#include <algorithm>
 #include <cstring>
 
 using namespace LAMMPS_NS;
@@ -43,10 +42,13 @@ namespace MK = MarshallKernels;
 /* ---------------------------------------------------------------------- */
 
 PairGranularOpt::PairGranularOpt(LAMMPS *lmp) :
-    PairGranular(lmp), fused_ready(false), generic_only(true), any_heat(false), sleep_fix(nullptr),
-    active_build(-1), active_generation(-1), ncontacts(0), hist_tangential(0), hist_rolling(0), hist_twisting(0)
+    PairGranular(lmp), fused_ready(false), generic_only(true), all_fused(false), any_heat(false),
+    sleep_fix(nullptr), active_build(-1), active_generation(-1), ncontacts(0), history_update(true),
+    hist_tangential(0), hist_rolling(0), hist_twisting(0)
 {
 }
+
+PairGranularOpt::~PairGranularOpt() = default;
 
 /* ---------------------------------------------------------------------- */
 
@@ -55,9 +57,36 @@ void PairGranularOpt::init_style()
   PairGranular::init_style();
   fused_ready = false;    // init_one() may still mix new models: set up before the first compute
   auto sleepers = modify->get_fix_by_style("^sleep/gran$");
-  sleep_fix = sleepers.empty() ? nullptr : dynamic_cast<FixSleepGran *>(sleepers.front());
+  sleep_fix = sleepers.empty() ? nullptr : sleepers.front();
   if (sleepers.size() > 1) error->all(FLERR, "Only one fix sleep/gran may be defined");
   active_build = active_generation = -1;
+}
+
+/* ---------------------------------------------------------------------- */
+
+void *PairGranularOpt::extract(const char *name, int &dim)
+{
+  if (strcmp(name, "sleep/gran:bookkeeping") == 0) {
+    // asked by fix sleep/gran's init(), after init_one() has mixed every model
+    if (!fused_ready) setup_fused();
+    dim = 0;
+    return all_fused && !fix_rigid ? this : nullptr;
+  }
+  return PairGranular::extract(name, dim);
+}
+
+/* ---------------------------------------------------------------------- */
+
+PairGranularOpt::SleepArrays PairGranularOpt::sleep_arrays() const
+{
+  SleepArrays s;
+  if (!sleep_fix) return s;
+  int dim = 0;
+  s.asleep = static_cast<const double *>(sleep_fix->extract("sleeping", dim));
+  s.push = static_cast<double **>(sleep_fix->extract("push", dim));
+  s.ncontact = static_cast<double *>(sleep_fix->extract("contacts", dim));
+  s.generation = *static_cast<bigint *>(sleep_fix->extract("generation", dim));
+  return s;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -116,8 +145,10 @@ void PairGranularOpt::setup_fused()
   // a heat model needs PairGranular's heat-flow bookkeeping, which the fused loop does not do
   bool any_fused = false;
   any_heat = false;
+  all_fused = true;
   for (int n = 0; n < nmodels; n++) {
     any_fused = any_fused || fused[n].on;
+    all_fused = all_fused && fused[n].on;
     any_heat = any_heat || models_list[n]->sub_models[HEAT]->name != "none";
   }
   generic_only = !any_fused || any_heat;
@@ -125,281 +156,368 @@ void PairGranularOpt::setup_fused()
 }
 
 /* ----------------------------------------------------------------------
-   PairGranular::compute() with the Marshall set fused. The generic branch is PairGranular's
-   loop body; the fused branch does what GranularModel::check_contact() and calculate_forces()
-   do with the Marshall sub-models, in the same order of operations, skipping what the set does
-   not use (relative tangential speed, heat, classic torque scaling). The history of a pair is
-   the same array at the same offsets, so fix neigh/history, restarts and single() see no
-   difference.
+   PairGranular::compute() with the Marshall set fused, as a recipe: set-up, gather (the
+   contacts' life decided, the pairs outside the fused set handed to PairGranular::compute on a
+   list of their own), the JKR roots in one batch, the fused kernel with its scatter and the
+   sleepers' bookkeeping per contact. The fused kernel does what GranularModel::check_contact()
+   and calculate_forces() do with the Marshall sub-models, in the same order of operations,
+   skipping what the set does not use (relative tangential speed, heat, classic torque scaling).
+   The history of a pair is the same array at the same offsets, so fix neigh/history, restarts
+   and single() see no difference.
 ------------------------------------------------------------------------- */
 
 void PairGranularOpt::compute(int eflag, int vflag)
 {
   if (!fused_ready) setup_fused();
-
-  if (sleep_fix && (any_heat || fix_rigid))
-    error->all(FLERR, "Fix sleep/gran cannot be used with a heat model or rigid bodies");
-  if (!sleep_fix && (generic_only || fix_rigid)) {
-    // nothing to fuse, a heat model, or rigid-body masses: the sub-model path does it all
+  // nothing to fuse, a heat model, rigid-body masses, or sleepers with a model outside the
+  // fused set (fix sleep/gran then does the bookkeeping itself): the sub-model path does it all
+  if (generic_only || fix_rigid || (sleep_fix && !all_fused)) {
     PairGranular::compute(eflag, vflag);
     return;
   }
-
-  const bool history_update = update->setupflag == 0;
-  for (int n = 0; n < nmodels; n++) models_list[n]->history_update = history_update;
-
-  ev_init(eflag, vflag);
-
-  int *type = atom->type;
-  double **x = atom->x;
-  double **v = atom->v;
-  double **f = atom->f;
-  double **omega = atom->omega;
-  double **torque = atom->torque;
-  double *radius = atom->radius;
-  double *rmass = atom->rmass;
-  int *mask = atom->mask;
-  const int nlocal = atom->nlocal;
-  const int newton_pair = force->newton_pair;
-  double *special_lj = force->special_lj;
-  const int size_hist = get_size_history();
-
-  const int inum = list->inum;
-  int *ilist = list->ilist;
-  int *numneigh = list->numneigh;
-  int **firstneigh = list->firstneigh;
-  int **firsttouch = use_history ? fix_history->firstflag : nullptr;
-  double **firsthistory = use_history ? fix_history->firstvalue : nullptr;
-
-  // sleepers: pairs of two sleepers are skipped (history kept); the sleeper's share of a pair
-  // with an awake atom is also summed into the fix's push array (its wake test)
-  const double *asleep = sleep_fix ? sleep_fix->sleeping() : nullptr;
-  double **push = sleep_fix ? sleep_fix->awake_push() : nullptr;
-  double *ncontact = sleep_fix ? sleep_fix->contact_count() : nullptr;
-  if (asleep) update_active(asleep);
-  const int nactive = asleep ? static_cast<int>(active.size()) : inum;
-  bigint contacts = 0;
-
-  // pass 1: the pairs that interact, in list order, their contact life decided (touch and
-  // history of an ended contact reset); the adhesive fused contacts' scaled overlaps collected
-  contact_i.clear();
-  contact_jj.clear();
-  jkr_overlap.clear();
-  for (int aa = 0; aa < nactive; aa++) {
-    const int ii = asleep ? active[aa] : aa;
-    const int i = ilist[ii];
-    const int itype = type[i];
-    int *touch = use_history ? firsttouch[i] : nullptr;
-    double *allhistory = use_history ? firsthistory[i] : nullptr;
-    int *jlist = firstneigh[i];
-    const int jnum = numneigh[i];
-
-    for (int jj = 0; jj < jnum; jj++) {
-      int j = jlist[jj];
-      if (special_lj[sbmask(j)] == 0) continue;
-      j &= NEIGHMASK;
-      if (asleep && asleep[i] != 0.0 && asleep[j] != 0.0) continue;
-      const int imodel = types_indices[itype][type[j]];
-      if (fused[imodel].on) {
-        FusedMarshall &fm = fused[imodel];
-        // contact geometry and life (GranularModel::check_contact, jkr/marshall touch)
-        double dx[3];
-        sub3(x[i], x[j], dx);
-        const double rsq = lensq3(dx);
-        const double radsum = radius[i] + radius[j];
-        // most neighbors of a deposition do not touch: reject those before R_eff and the scales
-        // (their history is zero already: zeroed when the contact ended, or new from the list)
-        if (!touch[jj] && rsq >= radsum * radsum) continue;
-        use_radii(fm, radius[i], radius[j]);
-        if (!MK::jkr_touch(touch[jj] != 0, rsq, radsum, fm.scales.deltac)) {
-          touch[jj] = 0;
-          double *history = &allhistory[size_hist * jj];
-          for (int k = 0; k < size_hist; k++) history[k] = 0.0;
-          continue;
-        }
-        touch[jj] = 1;
-        if (fm.gamma != 0.0) jkr_overlap.push_back(MK::scaled_overlap(fm.scales, radsum - sqrt(rsq)));
-      }
-      contact_i.push_back(i);
-      contact_jj.push_back(jj);
-    }
-  }
-
-  // the JKR roots of all adhesive contacts in one vectorised call
+  begin_step(eflag, vflag);
+  gather_contacts();
+  const bigint generic_contacts = generic_i.empty() ? 0 : compute_generic_pairs(eflag, vflag);
   jkr_root.resize(jkr_overlap.size());
   JKRScaled::roots(jkr_overlap.size(), jkr_overlap.data(), jkr_root.data());
+  compute_fused_contacts();
+  ncontacts = static_cast<bigint>(contacts.size()) + generic_contacts;
+}
 
-  // pass 2: the forces, pair by pair in list order (the sums of the one-pass loop)
-  std::size_t next_root = 0;
-  const std::size_t npairs = contact_i.size();
-  for (std::size_t c = 0; c < npairs; c++) {
-    const int i = contact_i[c];
-    const int jj = contact_jj[c];
-    const int itype = type[i];
-    int *touch = use_history ? firsttouch[i] : nullptr;
-    double *allhistory = use_history ? firsthistory[i] : nullptr;
-    int j = firstneigh[i][jj];
-    const double factor_lj = special_lj[sbmask(j)];
-    j &= NEIGHMASK;
+/* ----------------------------------------------------------------------
+   set-up of one compute(): history updates, tallies, the sleepers' arrays and active list,
+   the JKR scales of each type pair when every atom of a type has the same radius
+------------------------------------------------------------------------- */
 
-    const int jtype = type[j];
-    const int imodel = types_indices[itype][jtype];
-    GranularModel *model = models_list[imodel];
-    double *history = use_history ? &allhistory[size_hist * jj] : nullptr;
+void PairGranularOpt::begin_step(int eflag, int vflag)
+{
+  history_update = update->setupflag == 0;
+  for (int n = 0; n < nmodels; n++) models_list[n]->history_update = history_update;
+  ev_init(eflag, vflag);
+  sleep = sleep_arrays();
+  if (sleep.asleep) update_active(sleep.asleep, sleep.generation);
+  type_scales();
+}
 
-    double forces[3], torquesi[3], torquesj[3], dx[3];
-    if (fused[imodel].on) {
-      FusedMarshall &fm = fused[imodel];
-      sub3(x[i], x[j], dx);
-      const double rsq = lensq3(dx);
-      const double radi = radius[i];
-      const double radj = radius[j];
-      const double radsum = radi + radj;
-      use_radii(fm, radi, radj);
-      const double reff = fm.reff;
+/* ----------------------------------------------------------------------
+   per type pair: R_eff and the JKR scales, valid when all atoms (local and ghost) of both
+   types have one radius each (a monodisperse packing: two cube roots per type pair and step
+   instead of per contact)
+------------------------------------------------------------------------- */
 
-      const double mi = rmass[i];
-      const double mj = rmass[j];
-      if (mi != fm.mi || mj != fm.mj) {
-        fm.mi = mi;
-        fm.mj = mj;
-        fm.meff = mi * mj / (mi + mj);
-      }
-      double meff = fm.meff;
-      if (mask[i] & freeze_group_bit) meff = mj;
-      if (mask[j] & freeze_group_bit) meff = mi;
-      if (asleep) sleeper_mass(asleep[i], asleep[j], mi, mj, meff);
-      if (meff != fm.sqrt_mass_of) {
-        fm.sqrt_mass_of = meff;
-        fm.sqrt_mass = MK::damping_sqrt_mass(fm.mass_factor, meff);
-      }
-      const double dt = model->dt;
+void PairGranularOpt::type_scales()
+{
+  const int ntypes = atom->ntypes;
+  const int nall = atom->nlocal + atom->nghost;
+  const int *type = atom->type;
+  const double *radius = atom->radius;
+  type_radius.assign(ntypes + 1, -1.0);
+  std::vector<char> mixed(ntypes + 1, 0);
+  for (int i = 0; i < nall; i++) {
+    double &r = type_radius[type[i]];
+    if (r < 0.0)
+      r = radius[i];
+    else if (r != radius[i])
+      mixed[type[i]] = 1;
+  }
+  pair_scales.assign(static_cast<size_t>(ntypes + 1) * (ntypes + 1), PairScales());
+  for (int it = 1; it <= ntypes; it++)
+    for (int jt = 1; jt <= ntypes; jt++) {
+      const FusedMarshall &fm = fused[types_indices[it][jt]];
+      if (!fm.on || mixed[it] || mixed[jt] || type_radius[it] <= 0.0 || type_radius[jt] <= 0.0)
+        continue;
+      PairScales &ps = pair_scales[it * (ntypes + 1) + jt];
+      ps.valid = true;
+      ps.reff = MK::effective_radius(type_radius[it], type_radius[jt]);
+      ps.scales = MK::jkr_scales(ps.reff, fm.gamma, fm.emix);
+    }
+}
 
-      // kinematics (GranularModel::calculate_forces)
-      const double r = sqrt(rsq);
-      const double rinv = 1.0 / r;
-      const double delta = radsum - r;
-      double vr[3], nx[3], vn[3], vt[3], wr[3], temp[3], vtr[3];
-      sub3(v[i], v[j], vr);
-      scale3(rinv, dx, nx);
-      const double vnnr = dot3(vr, nx);
-      scale3(vnnr, nx, vn);
-      sub3(vr, vn, vt);
-      scaleadd3(radi, omega[i], radj, omega[j], wr);
-      cross3(wr, nx, temp);
-      sub3(vt, temp, vtr);
+/* ----------------------------------------------------------------------
+   R_eff and the JKR scales of pair i, j of a fused model (the type pair's if valid)
+------------------------------------------------------------------------- */
 
-      // normal: JKR with Marshall damping (the root from pass 1)
-      const MK::NormalForce nf = (fm.gamma != 0.0)
-          ? MK::jkr_normal_force_of_root(fm.scales, jkr_root[next_root++])
-          : MK::jkr_normal_force(fm.scales, fm.gamma, fm.emix, delta, reff);
-      const double damp_prefactor = MK::damping_prefactor(fm.alpha, fm.sqrt_mass, nf);
-      const double fntot = nf.fne + (-damp_prefactor * vnnr);
-      const double fncrit = MK::critical_force(nf);
+PairGranularOpt::PairScales PairGranularOpt::scales_of(int i, int j, const FusedMarshall &fm) const
+{
+  const int ntypes = atom->ntypes;
+  const PairScales &ps = pair_scales[atom->type[i] * (ntypes + 1) + atom->type[j]];
+  if (ps.valid) return ps;
+  PairScales mine;
+  mine.reff = MK::effective_radius(atom->radius[i], atom->radius[j]);
+  mine.scales = MK::jkr_scales(mine.reff, fm.gamma, fm.emix);
+  return mine;
+}
 
-      // sliding
-      double fs[3];
-      MK::tangential_force(&history[hist_tangential], nx, vtr, dt, fm.k_t * nf.a,
-                           damp_prefactor, fncrit * fm.mu, history_update, fs);
+/* ----------------------------------------------------------------------
+   the pairs that interact, in list order: a fused pair's contact life decided (touch and
+   history of an ended contact reset), its R_eff and scales and (adhesive) scaled overlap kept;
+   a pair of another model copied with its contact flag and history to the generic list
+------------------------------------------------------------------------- */
 
-      scale3(fntot, nx, forces);
-      add3(forces, fs, forces);
-      cross3(nx, fs, torquesi);
-      scale3(-1, torquesi);
-      copy3(torquesi, torquesj);
-      scale3(radi - 0.5 * delta, torquesi);
-      scale3(radj - 0.5 * delta, torquesj);
-
-      if (fm.rolling || fm.twisting) {
-        double relrot[3];
-        sub3(omega[i], omega[j], relrot);
-        if (fm.rolling) {
-          // rolling velocity, eq. 31 of Wang et al, Particuology 23, 49 (2015)
-          double vrl[3], fr[3], torroll[3];
-          vrl[0] = reff * (relrot[1] * nx[2] - relrot[2] * nx[1]);
-          vrl[1] = reff * (relrot[2] * nx[0] - relrot[0] * nx[2]);
-          vrl[2] = reff * (relrot[0] * nx[1] - relrot[1] * nx[0]);
-          MK::rolling_force(&history[hist_rolling], nx, vrl, dt,
-                            fm.theta_crit * (fm.roll_radius_factor * reff), nf.adhesive / reff,
-                            history_update, fr);
-          cross3(nx, fr, torroll);
-          scale3(reff, torroll);
-          add3(torquesi, torroll, torquesi);
-          sub3(torquesj, torroll, torquesj);
-        }
-        if (fm.twisting) {
-          // omega_T (eq. 29 of Marshall 2009)
-          const double magtwist = dot3(relrot, nx);
-          const double moment = MK::twisting_moment(history[hist_twisting], magtwist, dt, nf.a,
-                                                    fm.k_t, damp_prefactor, fm.mu * fncrit,
-                                                    history_update);
-          double tortwist[3];
-          scale3(moment, nx, tortwist);
-          add3(torquesi, tortwist, torquesi);
-          sub3(torquesj, tortwist, torquesj);
-        }
-      }
-    } else {
-      // PairGranular's sub-model path for this pair
-      model->xi = x[i];
-      model->xj = x[j];
-      model->radi = radius[i];
-      model->radj = radius[j];
-      model->i = i;
-      model->j = j;
-      model->itype = itype;
-      model->jtype = jtype;
-      if (use_history) model->touch = touch[jj];
-      if (!model->check_contact()) {
-        if (use_history) {
-          touch[jj] = 0;
-          for (int k = 0; k < size_hist; k++) history[k] = 0.0;
-        }
+void PairGranularOpt::gather_contacts()
+{
+  int *type = atom->type;
+  double **x = atom->x;
+  double *radius = atom->radius;
+  double *special_lj = force->special_lj;
+  const int size_hist = get_size_history();
+  const double *asleep = sleep.asleep;
+  const int inum = list->inum;
+  const int nactive = asleep ? static_cast<int>(active.size()) : inum;
+  contacts.clear();
+  jkr_overlap.clear();
+  generic_i.clear();
+  generic_jj.clear();
+  for (int aa = 0; aa < nactive; aa++) {
+    const int ii = asleep ? active[aa] : aa;
+    const int i = list->ilist[ii];
+    int *touch = use_history ? fix_history->firstflag[i] : nullptr;
+    double *allhistory = use_history ? fix_history->firstvalue[i] : nullptr;
+    const int *jlist = list->firstneigh[i];
+    const int jnum = list->numneigh[i];
+    for (int jj = 0; jj < jnum; jj++) {
+      const int j = jlist[jj] & NEIGHMASK;
+      if (special_lj[sbmask(jlist[jj])] == 0) continue;
+      if (asleep && asleep[i] != 0.0 && asleep[j] != 0.0) continue;
+      const FusedMarshall &fm = fused[types_indices[type[i]][type[j]]];
+      if (!fm.on) {
+        generic_i.push_back(i);
+        generic_jj.push_back(jj);
         continue;
       }
-      if (use_history) touch[jj] = 1;
-
-      const double mi = rmass[i];
-      const double mj = rmass[j];
-      double meff = mi * mj / (mi + mj);
-      if (mask[i] & freeze_group_bit) meff = mj;
-      if (mask[j] & freeze_group_bit) meff = mi;
-      if (asleep) sleeper_mass(asleep[i], asleep[j], mi, mj, meff);
-      model->meff = meff;
-      model->vi = v[i];
-      model->vj = v[j];
-      model->omegai = omega[i];
-      model->omegaj = omega[j];
-      model->history = history;
-      model->calculate_forces();
-      copy3(model->forces, forces);
-      copy3(model->torquesi, torquesi);
-      copy3(model->torquesj, torquesj);
-      copy3(model->dx, dx);
-    }
-
-    // apply forces & torques
-    contacts++;
-    scale3(factor_lj, forces);
-    add3(f[i], forces, f[i]);
-    scale3(factor_lj, torquesi);
-    add3(torque[i], torquesi, torque[i]);
-    if (newton_pair || j < nlocal) {
-      sub3(f[j], forces, f[j]);
-      scale3(factor_lj, torquesj);
-      add3(torque[j], torquesj, torque[j]);
-    }
-    if (evflag)
-      ev_tally_xyz(i, j, nlocal, newton_pair, 0.0, 0.0, forces[0], forces[1], forces[2], dx[0],
-                   dx[1], dx[2]);
-    if (asleep) {
-      ncontact[i] += 1.0;
-      if (newton_pair || j < nlocal) ncontact[j] += 1.0;
-      if (asleep[i] != 0.0) add3(push[i], forces, push[i]);
-      if (asleep[j] != 0.0 && (newton_pair || j < nlocal)) sub3(push[j], forces, push[j]);
+      double dx[3];
+      sub3(x[i], x[j], dx);
+      const double rsq = lensq3(dx);
+      const double radsum = radius[i] + radius[j];
+      // most neighbors of a deposition do not touch: reject those before R_eff and the scales
+      // (their history is zero already: zeroed when the contact ended, or new from the list)
+      if (!touch[jj] && rsq >= radsum * radsum) continue;
+      const PairScales ps = scales_of(i, j, fm);
+      if (!MK::jkr_touch(touch[jj] != 0, rsq, radsum, ps.scales.deltac)) {
+        touch[jj] = 0;
+        double *history = &allhistory[size_hist * jj];
+        for (int k = 0; k < size_hist; k++) history[k] = 0.0;
+        continue;
+      }
+      touch[jj] = 1;
+      if (fm.gamma != 0.0)
+        jkr_overlap.push_back(MK::scaled_overlap(ps.scales, radsum - sqrt(rsq)));
+      contacts.push_back({i, jj, ps});
     }
   }
-  ncontacts = contacts;
+}
+
+/* ----------------------------------------------------------------------
+   the pairs outside the fused set by PairGranular::compute itself, on a neighbor list (and
+   contact flags and histories) holding only them; their flags and histories are copied back
+------------------------------------------------------------------------- */
+
+bigint PairGranularOpt::compute_generic_pairs(int eflag, int vflag)
+{
+  const int nall = atom->nlocal + atom->nghost;
+  const int size_hist = use_history ? get_size_history() : 0;
+  const size_t n = generic_i.size();
+  generic_neigh.resize(n);
+  generic_touch.assign(n, 0);
+  generic_history.assign(n * size_hist, 0.0);
+  generic_atoms.clear();
+  generic_numneigh.assign(nall, 0);
+  generic_firstneigh.assign(nall, nullptr);
+  generic_firsttouch.assign(nall, nullptr);
+  generic_firsthistory.assign(nall, nullptr);
+  for (size_t k = 0; k < n; k++) {
+    const int i = generic_i[k], jj = generic_jj[k];
+    generic_neigh[k] = list->firstneigh[i][jj];
+    if (use_history) {
+      generic_touch[k] = fix_history->firstflag[i][jj];
+      const double *h = &fix_history->firstvalue[i][size_hist * jj];
+      std::copy(h, h + size_hist, &generic_history[size_hist * k]);
+    }
+    if (generic_numneigh[i]++ > 0) continue;    // the entries of one atom are consecutive
+    generic_atoms.push_back(i);
+    generic_firstneigh[i] = &generic_neigh[k];
+    generic_firsttouch[i] = &generic_touch[k];
+    generic_firsthistory[i] = &generic_history[size_hist * k];
+  }
+  if (!generic_list) {
+    generic_list = std::make_unique<NeighList>(lmp);
+    generic_list->copymode = 1;    // its arrays are this style's vectors: never freed by it
+  }
+  generic_list->inum = static_cast<int>(generic_atoms.size());
+  generic_list->ilist = generic_atoms.data();
+  generic_list->numneigh = generic_numneigh.data();
+  generic_list->firstneigh = generic_firstneigh.data();
+
+  NeighList *full = list;
+  int **flags = use_history ? fix_history->firstflag : nullptr;
+  double **values = use_history ? fix_history->firstvalue : nullptr;
+  list = generic_list.get();
+  if (use_history) {
+    fix_history->firstflag = generic_firsttouch.data();
+    fix_history->firstvalue = generic_firsthistory.data();
+  }
+  PairGranular::compute(eflag, vflag);
+  list = full;
+  if (!use_history) return 0;
+  fix_history->firstflag = flags;
+  fix_history->firstvalue = values;
+  bigint touching = 0;
+  for (size_t k = 0; k < n; k++) {
+    const int i = generic_i[k], jj = generic_jj[k];
+    flags[i][jj] = generic_touch[k];
+    touching += generic_touch[k] != 0;
+    std::copy(&generic_history[size_hist * k], &generic_history[size_hist * (k + 1)],
+              &values[i][size_hist * jj]);
+  }
+  return touching;
+}
+
+/* ----------------------------------------------------------------------
+   the fused contacts in list order: kernel, scatter, the sleepers' bookkeeping
+------------------------------------------------------------------------- */
+
+void PairGranularOpt::compute_fused_contacts()
+{
+  double *special_lj = force->special_lj;
+  std::size_t next_root = 0;
+  for (const Contact &c : contacts) {
+    int j = list->firstneigh[c.i][c.jj];
+    const double factor_lj = special_lj[sbmask(j)];
+    j &= NEIGHMASK;
+    PairForces pf;
+    fused_contact(c, j, next_root, pf);
+    scatter(c.i, j, factor_lj, pf);
+  }
+}
+
+/* ----------------------------------------------------------------------
+   the fused kernel for one contact (GranularModel::calculate_forces with the Marshall set)
+------------------------------------------------------------------------- */
+
+void PairGranularOpt::fused_contact(const Contact &c, int j, std::size_t &next_root,
+                                    PairForces &pf)
+{
+  const int i = c.i;
+  const FusedMarshall &fm = fused[types_indices[atom->type[i]][atom->type[j]]];
+  double **x = atom->x, **v = atom->v, **omega = atom->omega;
+  const double radi = atom->radius[i], radj = atom->radius[j];
+  const double reff = c.scales.reff;
+  double *history = &fix_history->firstvalue[i][get_size_history() * c.jj];
+  const double dt = models_list[types_indices[atom->type[i]][atom->type[j]]]->dt;
+
+  double *dx = pf.dx;
+  sub3(x[i], x[j], dx);
+  const double rsq = lensq3(dx);
+  const double sqrt_mass = MK::damping_sqrt_mass(fm.mass_factor, effective_mass(i, j));
+
+  // kinematics (GranularModel::calculate_forces)
+  const double r = sqrt(rsq);
+  const double rinv = 1.0 / r;
+  const double delta = radi + radj - r;
+  double vr[3], nx[3], vn[3], vt[3], wr[3], temp[3], vtr[3];
+  sub3(v[i], v[j], vr);
+  scale3(rinv, dx, nx);
+  const double vnnr = dot3(vr, nx);
+  scale3(vnnr, nx, vn);
+  sub3(vr, vn, vt);
+  scaleadd3(radi, omega[i], radj, omega[j], wr);
+  cross3(wr, nx, temp);
+  sub3(vt, temp, vtr);
+
+  // normal: JKR with Marshall damping (the root from the batch)
+  const MK::NormalForce nf = (fm.gamma != 0.0)
+      ? MK::jkr_normal_force_of_root(c.scales.scales, jkr_root[next_root++])
+      : MK::jkr_normal_force(c.scales.scales, fm.gamma, fm.emix, delta, reff);
+  const double damp_prefactor = MK::damping_prefactor(fm.alpha, sqrt_mass, nf);
+  const double fntot = nf.fne + (-damp_prefactor * vnnr);
+  const double fncrit = MK::critical_force(nf);
+
+  // sliding
+  double fs[3];
+  MK::tangential_force(&history[hist_tangential], nx, vtr, dt, fm.k_t * nf.a, damp_prefactor,
+                       fncrit * fm.mu, history_update, fs);
+
+  scale3(fntot, nx, pf.forces);
+  add3(pf.forces, fs, pf.forces);
+  cross3(nx, fs, pf.torquesi);
+  scale3(-1, pf.torquesi);
+  copy3(pf.torquesi, pf.torquesj);
+  scale3(radi - 0.5 * delta, pf.torquesi);
+  scale3(radj - 0.5 * delta, pf.torquesj);
+
+  if (!fm.rolling && !fm.twisting) return;
+  double relrot[3];
+  sub3(omega[i], omega[j], relrot);
+  if (fm.rolling) {
+    // rolling velocity, eq. 31 of Wang et al, Particuology 23, 49 (2015)
+    double vrl[3], fr[3], torroll[3];
+    vrl[0] = reff * (relrot[1] * nx[2] - relrot[2] * nx[1]);
+    vrl[1] = reff * (relrot[2] * nx[0] - relrot[0] * nx[2]);
+    vrl[2] = reff * (relrot[0] * nx[1] - relrot[1] * nx[0]);
+    MK::rolling_force(&history[hist_rolling], nx, vrl, dt,
+                      fm.theta_crit * (fm.roll_radius_factor * reff), nf.adhesive / reff,
+                      history_update, fr);
+    cross3(nx, fr, torroll);
+    scale3(reff, torroll);
+    add3(pf.torquesi, torroll, pf.torquesi);
+    sub3(pf.torquesj, torroll, pf.torquesj);
+  }
+  if (fm.twisting) {
+    // omega_T (eq. 29 of Marshall 2009)
+    const double magtwist = dot3(relrot, nx);
+    const double moment = MK::twisting_moment(history[hist_twisting], magtwist, dt, nf.a, fm.k_t,
+                                              damp_prefactor, fm.mu * fncrit, history_update);
+    double tortwist[3];
+    scale3(moment, nx, tortwist);
+    add3(pf.torquesi, tortwist, pf.torquesi);
+    sub3(pf.torquesj, tortwist, pf.torquesj);
+  }
+}
+
+/* ----------------------------------------------------------------------
+   m* of pair i, j; a frozen atom (fix freeze) or a sleeper is a fixed body: the other's mass
+------------------------------------------------------------------------- */
+
+double PairGranularOpt::effective_mass(int i, int j) const
+{
+  const double mi = atom->rmass[i], mj = atom->rmass[j];
+  double meff = mi * mj / (mi + mj);
+  const int *mask = atom->mask;
+  if (mask[i] & freeze_group_bit) meff = mj;
+  if (mask[j] & freeze_group_bit) meff = mi;
+  if (sleep.asleep) {
+    if (sleep.asleep[i] != 0.0) meff = mj;
+    if (sleep.asleep[j] != 0.0) meff = mi;
+  }
+  return meff;
+}
+
+/* ----------------------------------------------------------------------
+   forces and torques to the atoms, the tallies, and the sleepers' contact count and push
+------------------------------------------------------------------------- */
+
+void PairGranularOpt::scatter(int i, int j, double factor_lj, PairForces &pf)
+{
+  double **f = atom->f, **torque = atom->torque;
+  const int nlocal = atom->nlocal;
+  const bool j_here = force->newton_pair || j < nlocal;
+  scale3(factor_lj, pf.forces);
+  add3(f[i], pf.forces, f[i]);
+  scale3(factor_lj, pf.torquesi);
+  add3(torque[i], pf.torquesi, torque[i]);
+  if (j_here) {
+    sub3(f[j], pf.forces, f[j]);
+    scale3(factor_lj, pf.torquesj);
+    add3(torque[j], pf.torquesj, torque[j]);
+  }
+  if (evflag)
+    ev_tally_xyz(i, j, nlocal, force->newton_pair, 0.0, 0.0, pf.forces[0], pf.forces[1],
+                 pf.forces[2], pf.dx[0], pf.dx[1], pf.dx[2]);
+  if (!sleep.asleep) return;
+  sleep.ncontact[i] += 1.0;
+  if (j_here) sleep.ncontact[j] += 1.0;
+  if (sleep.asleep[i] != 0.0) add3(sleep.push[i], pf.forces, sleep.push[i]);
+  if (sleep.asleep[j] != 0.0 && j_here) sub3(sleep.push[j], pf.forces, sleep.push[j]);
 }
 
 /* ----------------------------------------------------------------------
@@ -407,11 +525,11 @@ void PairGranularOpt::compute(int eflag, int vflag)
    neighbor
 ------------------------------------------------------------------------- */
 
-void PairGranularOpt::update_active(const double *asleep)
+void PairGranularOpt::update_active(const double *asleep, bigint generation)
 {
-  if (active_build == neighbor->lastcall && active_generation == sleep_fix->generation()) return;
+  if (active_build == neighbor->lastcall && active_generation == generation) return;
   active_build = neighbor->lastcall;
-  active_generation = sleep_fix->generation();
+  active_generation = generation;
   active.clear();
   const int inum = list->inum;
   for (int ii = 0; ii < inum; ii++) {
@@ -420,35 +538,5 @@ void PairGranularOpt::update_active(const double *asleep)
     const int *jlist = list->firstneigh[i];
     for (int jj = 0; !keep && jj < list->numneigh[i]; jj++) keep = asleep[jlist[jj] & NEIGHMASK] == 0.0;
     if (keep) active.push_back(ii);
-  }
-}
-
-/* ---------------------------------------------------------------------- */
-
-void PairGranularOpt::mark_touching_sleepers(const double *flag, double *mark) const
-{
-  double **x = atom->x;
-  double *radius = atom->radius;
-  for (int ii = 0; ii < list->inum; ii++) {
-    const int i = list->ilist[ii];
-    const int *jlist = list->firstneigh[i];
-    const int *touch = use_history ? fix_history->firstflag[i] : nullptr;
-    for (int jj = 0; jj < list->numneigh[i]; jj++) {
-      const int j = jlist[jj] & NEIGHMASK;
-      const bool pushed_sleeper = (flag[i] < 0.0 && flag[j] > 0.0) || (flag[j] < 0.0 && flag[i] > 0.0);
-      if (!pushed_sleeper) continue;
-      bool touching;
-      if (touch) {
-        touching = touch[jj] != 0;
-      } else {
-        double dx[3];
-        sub3(x[i], x[j], dx);
-        const double radsum = radius[i] + radius[j];
-        touching = lensq3(dx) < radsum * radsum;
-      }
-      if (!touching) continue;
-      if (flag[i] > 0.0) mark[i] = 1.0;
-      if (flag[j] > 0.0) mark[j] = 1.0;
-    }
   }
 }

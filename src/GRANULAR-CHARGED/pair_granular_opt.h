@@ -19,6 +19,7 @@ PairStyle(granular/opt,PairGranularOpt);
 #include "marshall_kernels.h"
 #include "pair_granular.h"
 
+#include <memory>
 #include <vector>
 
 namespace LAMMPS_NS {
@@ -26,21 +27,22 @@ namespace LAMMPS_NS {
 // pair_style granular with a fused kernel for the Marshall sub-model set (jkr/marshall,
 // damping marshall[/printed], tangential marshall, optional rolling marshall[/particle] and
 // twisting marshall/jkr): one pass per neighbor pair through the inline equations of
-// marshall_kernels.h, no virtual calls. Every other type pair runs PairGranular's sub-model
-// path. Same pair_coeff syntax, history layout, restart and single() as granular
+// marshall_kernels.h, no virtual calls. Every other type pair runs PairGranular::compute on a
+// list of those pairs only. Same pair_coeff syntax, history layout, restart and single() as granular
 // (doc/pair_granular_jkr_marshall.md, "pair_style granular/opt").
 class PairGranularOpt : public PairGranular {
  public:
   PairGranularOpt(class LAMMPS *);
+  ~PairGranularOpt() override;
   void compute(int, int) override;
   void init_style() override;
 
   // for tests and the log: does model n run the fused kernel?
   bool model_is_fused(int n) const;
 
-  // fix sleep/gran: set mark[j] = 1 for every sleeper j (flag 1) touching an atom flagged -1
-  // (local and ghost atoms of this rank's list)
-  void mark_touching_sleepers(const double *flag, double *mark) const;
+  // "sleep/gran:bookkeeping": this style skips the pairs of two sleepers of fix sleep/gran,
+  // treats a sleeper as a fixed body and sums the fix's push and contact counts in its loop
+  void *extract(const char *, int &) override;
   // contacts (touching pairs) whose forces the last compute() evaluated in its own loop
   bigint contacts_computed() const { return ncontacts; }
 
@@ -58,47 +60,69 @@ class PairGranularOpt : public PairGranular {
     double theta_crit = 0.0;          // critical rolling angle
     double roll_radius_factor = 1.0;  // rolling limit at theta_crit x this x R_eff
     bool twisting = false;            // twisting marshall/jkr defined
-    MarshallKernels::JKRScales scales;    // delta_C, a_sep, F_C of the last R_eff
-    // the last pair's radii and masses: a monodisperse packing divides and takes roots once
-    double radi = -1.0, radj = -1.0, reff = 0.0;      // R_eff (and scales) of radii radi, radj
-    double mi = -1.0, mj = -1.0, meff = 0.0;          // m* of masses mi, mj
-    double sqrt_mass_of = -1.0, sqrt_mass = 0.0;      // sqrt(mass_factor m*) of m* = sqrt_mass_of
   };
   std::vector<FusedMarshall> fused;      // one per entry of models_list
   bool fused_ready;                      // false after init_style(): rebuild before compute()
   bool generic_only;                     // no model fused (or a heat model): PairGranular's path
+  bool all_fused;                        // every model fused (then sleepers are handled here)
   bool any_heat;                         // a model with heat conduction
-  class FixSleepGran *sleep_fix;         // fix sleep/gran, if defined
+  class Fix *sleep_fix;                  // fix sleep/gran, if defined (read through extract())
+  // the fix's arrays for this compute() (extract() names of fix_sleep_gran.h)
+  struct SleepArrays {
+    const double *asleep = nullptr;    // 1.0 sleeping, 0.0 awake
+    double **push = nullptr;           // contact force from awake partners on a sleeper
+    double *ncontact = nullptr;        // contacts computed this step
+    bigint generation = 0;             // changes with the sleeping set
+  };
+  SleepArrays sleep_arrays() const;
+  SleepArrays sleep;                     // of this compute()
   // with sleepers: the list entries ii whose atom is awake or has an awake neighbor, rebuilt
   // after each neighbor list build and each change of the sleeping set
   std::vector<int> active;
   bigint active_build, active_generation;
   bigint ncontacts;
+  bool history_update;                   // this compute() advances the contact histories
   int hist_tangential, hist_rolling, hist_twisting;    // offsets in the per-pair history
 
+  // R_eff and the JKR scales of one pair (of a type pair whose atoms all have one radius each)
+  struct PairScales {
+    bool valid = false;
+    double reff = 0.0;
+    MarshallKernels::JKRScales scales;
+  };
+  std::vector<double> type_radius;       // radius of every atom of a type (-1: none)
+  std::vector<PairScales> pair_scales;   // per type pair (itype * (ntypes + 1) + jtype)
+  // one fused contact of this compute(): atom, index in its neighbor list, its scales
+  struct Contact {
+    int i, jj;
+    PairScales scales;
+  };
+  std::vector<Contact> contacts;
+  std::vector<double> jkr_overlap, jkr_root;    // the adhesive contacts' scaled overlaps, roots
+  struct PairForces {
+    double forces[3], torquesi[3], torquesj[3], dx[3];
+  };
+  // the pairs outside the fused set (atom, index in its list) and their list for
+  // PairGranular::compute, with copies of their contact flags and histories
+  std::vector<int> generic_i, generic_jj;
+  std::unique_ptr<class NeighList> generic_list;
+  std::vector<int> generic_atoms, generic_numneigh, generic_neigh, generic_touch;
+  std::vector<int *> generic_firstneigh, generic_firsttouch;
+  std::vector<double> generic_history;
+  std::vector<double *> generic_firsthistory;
+
   void setup_fused();
-  // a sleeper is a fixed body, as an atom of fix freeze: the effective mass is the other's
-  static void sleeper_mass(double sleep_i, double sleep_j, double mi, double mj, double &meff)
-  {
-    if (sleep_i != 0.0) meff = mj;
-    if (sleep_j != 0.0) meff = mi;
-  }
-  void update_active(const double *asleep);
-
-  // R_eff and the JKR scales of the pair's radii (recomputed only when they change)
-  static void use_radii(FusedMarshall &fm, double radi, double radj)
-  {
-    if (radi == fm.radi && radj == fm.radj) return;
-    fm.radi = radi;
-    fm.radj = radj;
-    fm.reff = radi * radj / (radi + radj);
-    MarshallKernels::use_jkr_scales(fm.scales, fm.reff, fm.gamma, fm.emix);
-  }
-
-  // compute()'s two passes: the interacting pairs (atom, index in its neighbor list) and the
-  // scaled overlaps and JKR roots of the adhesive fused ones, in pair order
-  std::vector<int> contact_i, contact_jj;
-  std::vector<double> jkr_overlap, jkr_root;
+  void update_active(const double *asleep, bigint generation);
+  // the steps of compute()
+  void begin_step(int eflag, int vflag);
+  void type_scales();
+  void gather_contacts();
+  bigint compute_generic_pairs(int eflag, int vflag);
+  void compute_fused_contacts();
+  void fused_contact(const Contact &c, int j, std::size_t &next_root, PairForces &pf);
+  void scatter(int i, int j, double factor_lj, PairForces &pf);
+  PairScales scales_of(int i, int j, const FusedMarshall &fm) const;
+  double effective_mass(int i, int j) const;
 };
 
 }    // namespace LAMMPS_NS

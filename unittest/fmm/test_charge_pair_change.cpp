@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "gcfmm/charge_pair_change.hpp"
-#include "gcfmm/simd.hpp"
+#include "gcsimd/simd.hpp"
 
 using namespace gcfmm;
 
@@ -65,10 +65,10 @@ void scalar(const double now[3], const double then[3], double dg[4]) {
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0 || (a == 0.0 && b == 0.0); }
 
-std::vector<SimdPath> available_paths() {
-  std::vector<SimdPath> paths;
-  for (SimdPath p : {SimdPath::Generic, SimdPath::AVX2, SimdPath::AVX512})
-    if (simd_path_available(p)) paths.push_back(p);
+std::vector<gcsimd::SimdPath> available_paths() {
+  std::vector<gcsimd::SimdPath> paths;
+  for (gcsimd::SimdPath p : {gcsimd::SimdPath::Generic, gcsimd::SimdPath::AVX2, gcsimd::SimdPath::AVX512})
+    if (gcsimd::simd_path_available(p)) paths.push_back(p);
   return paths;
 }
 
@@ -80,7 +80,7 @@ TEST(ChargePairChange, EveryPathGivesTheScalarBits) {
   std::vector<std::size_t> counts;
   for (std::size_t n = 0; n < 20; ++n) counts.push_back(n);
   counts.push_back(1037);
-  for (SimdPath path : available_paths()) {
+  for (gcsimd::SimdPath path : available_paths()) {
     for (std::size_t n : counts) {
       const Pairs p = random_pairs(n, 7 + n);
       Out out(n);
@@ -93,7 +93,7 @@ TEST(ChargePairChange, EveryPathGivesTheScalarBits) {
         const double got[4] = {out.ex[k], out.ey[k], out.ez[k], out.pot[k]};
         for (int c = 0; c < 4; ++c)
           ASSERT_TRUE(same_bits(got[c], dg[c]))
-              << simd_path_name(path) << " n " << n << " pair " << k << " component " << c << ": " << got[c]
+              << gcsimd::simd_path_name(path) << " n " << n << " pair " << k << " component " << c << ": " << got[c]
               << " != " << dg[c];
         EXPECT_EQ(out.r2n[k], now[0] * now[0] + now[1] * now[1] + now[2] * now[2]);
         EXPECT_EQ(out.r2t[k], then[0] * then[0] + then[1] * then[1] + then[2] * then[2]);
@@ -110,7 +110,7 @@ TEST(ChargePairChange, EveryPathGivesTheScalarBits) {
 TEST(ChargePairChange, IsTheKernelDifference) {
   const std::size_t n = 64;
   const Pairs p = random_pairs(n, 3);
-  for (SimdPath path : available_paths()) {
+  for (gcsimd::SimdPath path : available_paths()) {
     Out out(n);
     charge_pair_change(n, {p.nx.data(), p.ny.data(), p.nz.data()}, {p.tx.data(), p.ty.data(), p.tz.data()},
                        out.view(), path);

@@ -123,19 +123,19 @@ TEST(P2P, DirectImagesMatchesShiftedCopies) {
   }
 }
 
-// Every instruction-set path available on this CPU (include/gcfmm/simd.hpp) against the
+// Every instruction-set path available on this CPU (gcsimd/simd.hpp, src/simd) against the
 // generic one: P2P (the AVX-512 path is a different kernel, rsqrt14 + Newton) and the batched
 // P2M, M2L and L2P; round-off only.
 TEST(P2P, EverySimdPathMatchesGeneric) {
   auto src = gcfmm_test::random_cube(301, 31);
   auto tgt = gcfmm_test::random_cube(97, 32, 1.5);
-  for (SimdPath path : {SimdPath::AVX2, SimdPath::AVX512}) {
-    if (!simd_path_available(path)) {
-      std::printf("[ skipped  ] path %s not available on this CPU\n", simd_path_name(path));
+  for (gcsimd::SimdPath path : {gcsimd::SimdPath::AVX2, gcsimd::SimdPath::AVX512}) {
+    if (!gcsimd::simd_path_available(path)) {
+      std::printf("[ skipped  ] path %s not available on this CPU\n", gcsimd::simd_path_name(path));
       continue;
     }
     gcfmm_test::Field a(tgt.size()), b(tgt.size());
-    p2p_with(SimdPath::Generic, tgt.size(), tgt.x.data(), tgt.y.data(), tgt.z.data(), src.size(), src.x.data(),
+    p2p_with(gcsimd::SimdPath::Generic, tgt.size(), tgt.x.data(), tgt.y.data(), tgt.z.data(), src.size(), src.x.data(),
              src.y.data(), src.z.data(), src.q.data(), 0.1, -0.2, 0.3, a.pot.data(), a.ex.data(), a.ey.data(),
              a.ez.data());
     p2p_with(path, tgt.size(), tgt.x.data(), tgt.y.data(), tgt.z.data(), src.size(), src.x.data(), src.y.data(),
@@ -145,10 +145,10 @@ TEST(P2P, EverySimdPathMatchesGeneric) {
       EXPECT_LT(std::abs(a.pot[i] - b.pot[i]) + std::abs(a.ex[i] - b.ex[i]) + std::abs(a.ey[i] - b.ey[i]) +
                     std::abs(a.ez[i] - b.ez[i]),
                 1e-13 * s)
-          << simd_path_name(path) << " target " << i;
+          << gcsimd::simd_path_name(path) << " target " << i;
     }
     for (int p : {4, 9, 18}) {
-      Operators g(p, SimdPath::Generic), v(p, path);
+      Operators g(p, gcsimd::SimdPath::Generic), v(p, path);
       std::vector<double> Mg(g.size(), 0.0), Mv(g.size(), 0.0), Lg(g.size(), 0.0), Lv(g.size(), 0.0);
       const Vec3 c{0.5, 0.5, 0.5};
       g.p2m_batch(src.size(), src.x.data(), src.y.data(), src.z.data(), src.q.data(), c, Mg.data());
@@ -167,8 +167,8 @@ TEST(P2P, EverySimdPathMatchesGeneric) {
         dl = std::max(dl, std::abs(Lg[i] - Lv[i]));
         sl = std::max(sl, std::abs(Lg[i]));
       }
-      EXPECT_LT(dm, 1e-13 * sm) << simd_path_name(path) << " p2m p=" << p;
-      EXPECT_LT(dl, 1e-13 * sl) << simd_path_name(path) << " m2l p=" << p;
+      EXPECT_LT(dm, 1e-13 * sm) << gcsimd::simd_path_name(path) << " p2m p=" << p;
+      EXPECT_LT(dl, 1e-13 * sl) << gcsimd::simd_path_name(path) << " m2l p=" << p;
       g.symmetrize(Lg.data());
       gcfmm_test::Field fg(tgt.size()), fv(tgt.size());
       g.l2p_batch(Lg.data(), c, tgt.size(), tgt.x.data(), tgt.y.data(), tgt.z.data(), fg.pot.data(), fg.ex.data(),
@@ -178,7 +178,7 @@ TEST(P2P, EverySimdPathMatchesGeneric) {
       for (std::size_t i = 0; i < tgt.size(); ++i)
         EXPECT_LT(std::abs(fg.ez[i] - fv.ez[i]) + std::abs(fg.pot[i] - fv.pot[i]),
                   1e-12 * (std::abs(fg.ez[i]) + std::abs(fg.pot[i])))
-            << simd_path_name(path) << " l2p p=" << p << " target " << i;
+            << gcsimd::simd_path_name(path) << " l2p p=" << p << " target " << i;
     }
   }
 }

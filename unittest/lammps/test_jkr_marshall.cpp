@@ -132,13 +132,13 @@ TEST(JKRMarshall, BatchedRootsAreTheScalarRoot)
   for (std::size_t k = 0; k < Delta.size(); ++k) expect[k] = root(Delta[k]);
   for (int path = 0; path <= 2; ++path) {
     std::vector<double> s(Delta.size(), -7.0);
-    roots(Delta.size(), Delta.data(), s.data(), static_cast<gcfmm::SimdPath>(path));
+    roots(Delta.size(), Delta.data(), s.data(), static_cast<gcsimd::SimdPath>(path));
     for (std::size_t k = 0; k < Delta.size(); ++k)
       ASSERT_EQ(s[k], expect[k]) << "path " << path << ", Delta = " << Delta[k];
     for (std::size_t start = 0; start < 4; ++start)
       for (std::size_t n = 0; n < 20; ++n) {
         std::vector<double> part(n + 1, -7.0);
-        roots(n, &Delta[start], part.data(), static_cast<gcfmm::SimdPath>(path));
+        roots(n, &Delta[start], part.data(), static_cast<gcsimd::SimdPath>(path));
         for (std::size_t k = 0; k < n; ++k) ASSERT_EQ(part[k], expect[start + k]);
         ASSERT_EQ(part[n], -7.0);    // nothing written past n
       }

@@ -1,4 +1,4 @@
-/* GRANULAR-CHARGED: fix sleep/gran with pair_style granular/opt.
+/* GRANULAR-CHARGED: fix sleep/gran with pair_style granular/opt and pair_style granular.
 
    - Held and skipped: a bed whose atoms all sleep does not move by one bit, its contacts are
      not computed (the pair style's count of evaluated contacts is 0; it is > 0 without the fix)
@@ -14,13 +14,19 @@
    - Static sleepers in fix coul/fmm: the forces on the awake atoms and the energy, with the
      sleeping charges as a static source at accuracy 1e-4 and 1e-6, against a full evaluation
      of all charges at 1e-9 (sleepers full), on 1 and 2 ranks; the refused combinations.
-   - Bad input: every refused keyword value, a pair style other than granular/opt, a point
+   - With pair_style granular (the fix counts the contacts and sums the push itself): a bed
+     whose atoms all sleep does not move by one bit (an atom sleeps only with a counted
+     contact), a pushed sleeper wakes with the sleeper touching it, and below the threshold
+     nothing wakes.
+   - Bad input: every refused keyword value, a pair style other than granular[/opt], a point
      particle atom style, a fix that adds forces after it, an injection into another group.
 
    Checked against broken code: without the skip in the pair loop HeldAndSkipped fails (contacts
    > 0); without zeroing the velocities of sleepers it fails (the bed moves); with the sleeper's
    push summed with the wrong sign or not at all, WakesWhenPushed fails; without pack_exchange
-   of the flags the two-rank migration fails; without pack_restart the restart fails. */
+   of the flags the two-rank migration fails; without pack_restart the restart fails; with the
+   fix's own contact count removed BaseStyleHoldsAndWakes fails (nothing sleeps), and with its
+   push sum removed it fails (nothing wakes). */
 #include "gc_testing.h"
 
 #include "atom.h"
@@ -120,14 +126,14 @@ TEST(FixSleepGran, HeldAndSkipped)
 
 // sphere 1 and sphere 3 below it, touching (an atom sleeps only in contact), sleep (the fix
 // group); sphere 2 hits sphere 1 at 0.3 m/s
-std::vector<std::string> impact(const std::string &hold)
+std::vector<std::string> impact(const std::string &hold, const std::string &pair = "granular/opt")
 {
   return {"units si", "atom_style sphere", "atom_modify map array", "boundary f f f",
           "newton off", "comm_modify vel yes", "region box block -1e-5 1e-5 -1e-5 1e-5 -1e-5 1e-5",
           "create_box 1 box", "create_atoms 1 single 0 0 0", "create_atoms 1 single 0.8e-6 0.3e-6 2.1e-6",
           "create_atoms 1 single 0 0 -1.999e-6",
           "set group all diameter 2.0e-6", "set group all density 2500", "group one id 1 3",
-          "group two id 2", "pair_style granular/opt", std::string("pair_coeff * * ") + MODEL,
+          "group two id 2", "pair_style " + pair, std::string("pair_coeff * * ") + MODEL,
           "neighbor 2e-7 bin", "neigh_modify every 1 delay 0 check yes",
           "velocity two set 0.01 -0.02 -0.3", "set atom 2 omega 1e4 -2e4 3e3",
           "fix integrate all nve/sphere", "timestep 5e-9", "thermo 0", hold};
@@ -155,28 +161,52 @@ TEST(FixSleepGran, SleeperIsAFixedBody)
   EXPECT_GT(std::abs(b.var("vz[2]") + 0.3), 0.01);
 }
 
-TEST(FixSleepGran, WakesWhenPushed)
+// sphere 3 below sphere 1, touching it: both sleep; sphere 2 hits 1. Below the wake threshold
+// nothing wakes; above it sphere 1 wakes, and sphere 3 with it
+void expect_wakes_when_pushed(const std::string &pair)
 {
-  if (nprocs() > 1) GTEST_SKIP() << "single-rank test";
-  // sphere 3 below sphere 1, touching it: both sleep; sphere 2 hits 1
-  auto cmds = impact("group bedg id 1 3");
+  auto cmds = impact("group bedg id 1 3", pair);
   {
     Lmp l;
     l.cmds(cmds);
-    l.cmd("fix sleep bedg sleep/gran speed 1e3 force 1.0 wake 1e3 time 0 every 1");
-    l.cmd("run 3000");
-    EXPECT_EQ(l.var("f_sleep[4]"), 0.0) << "push below wake: nothing wakes";
+    l.cmds({"fix sleep bedg sleep/gran speed 1e3 force 1e-6 wake 1e3 time 0 every 1", "run 3000"});
+    EXPECT_EQ(l.var("f_sleep[2]"), 2.0) << pair;
+    EXPECT_EQ(l.var("f_sleep[4]"), 0.0) << pair << ": push below wake, nothing wakes";
   }
   // the impact pushes with ~3e-8 N, m U / t_c (F_C = 3 pi gamma R = 9.4e-8 N)
   Lmp m;
   m.cmds(cmds);
   // the pair 1-3 snaps into JKR contact (3.6e-8 N): at rest means here a net force below 1e-6 N
   m.cmds({"fix sleep bedg sleep/gran speed 1e3 force 1e-6 wake 1e-8 time 0 every 1", "run 1"});
-  EXPECT_EQ(m.var("f_sleep[2]"), 2.0) << "both at rest at step 1";
+  EXPECT_EQ(m.var("f_sleep[2]"), 2.0) << pair << ": both at rest at step 1";
   const double z1 = m.var("z[1]");
   m.cmd("run 3000");
-  EXPECT_GE(m.var("f_sleep[4]"), 2.0) << "sphere 1 pushed, sphere 3 touching it";
-  EXPECT_NE(m.var("z[1]"), z1) << "sphere 1 moves once awake";
+  EXPECT_GE(m.var("f_sleep[4]"), 2.0) << pair << ": sphere 1 pushed, sphere 3 touching it";
+  EXPECT_NE(m.var("z[1]"), z1) << pair << ": sphere 1 moves once awake";
+}
+
+TEST(FixSleepGran, WakesWhenPushed)
+{
+  if (nprocs() > 1) GTEST_SKIP() << "single-rank test";
+  expect_wakes_when_pushed("granular/opt");
+}
+
+// the base style computes every contact; the fix finds the contacts and the push itself
+TEST(FixSleepGran, BaseStyleHoldsAndWakes)
+{
+  {
+    Lmp l;
+    l.cmds(bed("granular"));
+    l.cmds({ALL_SLEEP, "run 1"});
+    EXPECT_EQ(l.var("f_sleep[2]"), 27.0) << "every atom touches another: all sleep";
+    l.cmd("run 1");
+    const auto x0 = positions(l);
+    l.cmd("run 500");
+    EXPECT_EQ(l.var("f_sleep[2]"), 27.0);
+    const auto x1 = positions(l);
+    for (size_t k = 0; k < x0.size(); ++k) EXPECT_EQ(x0[k], x1[k]) << "coordinate " << k;
+  }
+  if (nprocs() == 1) expect_wakes_when_pushed("granular");    // a single-rank set-up
 }
 
 TEST(FixSleepGran, RestartKeepsTheFlags)
@@ -323,7 +353,14 @@ TEST(FixSleepGran, BadInput)
   expect_match(err(ok + " depth -2e-6"), "depth must be > 0, got -2e-6");
   expect_match(err(ok + " bogus 1"), "Unknown fix sleep/gran keyword bogus");
   expect_match(err("fix s all sleep/gran speed 1e-3 force 1e-8"), "needs the keywords speed, force, wake and time");
-  expect_match(err(ok, "granular"), "requires pair_style granular/opt.*not granular");
+  EXPECT_EQ(err(ok, "granular"), "no error");
+  {
+    auto c = bed("zero 1e-6");
+    for (auto &line : c)
+      if (line.rfind("pair_coeff", 0) == 0) line = "pair_coeff * *";
+    c.insert(c.end(), {ok, "run 0"});
+    expect_match(error_of(c), "requires pair_style granular or granular/opt, not zero");
+  }
   expect_match(err(ok, "granular/opt", {"fix late all gravity 1 vector 0 0 -1"}),
                "must be defined after every fix that adds forces; fix late \\(gravity\\)");
   expect_match(err(ok, "granular/opt",

@@ -9,7 +9,7 @@
 #include <cmath>
 
 #include "gcfmm/dipole_kernels.hpp"
-#include "gcfmm/simd_paths.hpp"
+#include "gcsimd/simd_paths.hpp"
 
 namespace gcfmm {
 
@@ -17,12 +17,12 @@ namespace {
 
 // exact 1/|d| (vsqrtpd, vdivpd where vectorised), 0 for d = 0 (charge_terms then adds nothing);
 // computed for every lane (inf for d = 0) and then selected
-GCFMM_ALWAYS_INLINE double inverse_distance(double r2) {
+GCSIMD_ALWAYS_INLINE double inverse_distance(double r2) {
   const double inv = 1.0 / std::sqrt(r2);
   return r2 > 0.0 ? inv : 0.0;
 }
 
-GCFMM_ALWAYS_INLINE void change_loop(std::size_t n, const double *__restrict nx, const double *__restrict ny,
+GCSIMD_ALWAYS_INLINE void change_loop(std::size_t n, const double *__restrict nx, const double *__restrict ny,
                                      const double *__restrict nz, const double *__restrict tx,
                                      const double *__restrict ty, const double *__restrict tz,
                                      double *__restrict ex, double *__restrict ey, double *__restrict ez,
@@ -49,12 +49,12 @@ GCFMM_ALWAYS_INLINE void change_loop(std::size_t n, const double *__restrict nx,
    double *r2then)
 #define GCFMM_CHANGE_ARGS (n, nx, ny, nz, tx, ty, tz, ex, ey, ez, pot, r2now, r2then)
 
-GCFMM_DEFINE_SIMD_PATHS(void, change_kernel, GCFMM_CHANGE_PARAMS, change_loop, GCFMM_CHANGE_ARGS)
+GCSIMD_DEFINE_PATHS(void, change_kernel, GCFMM_CHANGE_PARAMS, change_loop, GCFMM_CHANGE_ARGS)
 
 }  // namespace
 
 void charge_pair_change(std::size_t n, Separations now, Separations then, ChargePairChange out,
-                        SimdPath path) {
+                        gcsimd::SimdPath path) {
   change_kernel_for(path)(n, now.x, now.y, now.z, then.x, then.y, then.z, out.ex, out.ey, out.ez, out.pot,
                           out.r2now, out.r2then);
 }

@@ -8,7 +8,7 @@
 #include "gcfmm/expansions.hpp"
 
 #include "gcfmm/options.hpp"
-#include "gcfmm/simd_paths.hpp"
+#include "gcsimd/simd_paths.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -34,7 +34,7 @@ constexpr int kLanes = Operators::kBatch;
 //! rows n <= kMaxFixedRow of the M2L sum are compiled with n known (outputs in registers)
 constexpr int kMaxFixedRow = 16;
 
-inline int idx(int n, int m) { return n * n + n + m; }
+inline constexpr int idx(int n, int m) { return Operators::index(n, m); }
 
 enum class Kind { Regular, Irregular };
 
@@ -47,7 +47,7 @@ enum class Kind { Regular, Irregular };
 //   T_n^m = ((2n-1) z T_{n-1}^m - (n-1+m)(n-1-m) T_{n-2}^m) / r^2.
 // `tab` is inv_nm (regular) or nm1 (irregular), indexed [n * (p + 1) + m].
 template <Kind K, int W>
-GCFMM_ALWAYS_INLINE void solid_harmonics(int nmax, int p, const double *tab, const double *x, const double *y, const double *z,
+GCSIMD_ALWAYS_INLINE void solid_harmonics(int nmax, int p, const double *tab, const double *x, const double *y, const double *z,
                      double *__restrict Xr, double *__restrict Xi) {
   double r2[W], ir2[W];
   for (int v = 0; v < W; ++v) {
@@ -101,7 +101,7 @@ GCFMM_ALWAYS_INLINE void solid_harmonics(int nmax, int p, const double *tab, con
 
 // m < 0 from X_n^{-m} = (-1)^m conj(X_n^m) (doc/theory.md, eq. (3.4)), lane-major, n <= nmax
 template <int W>
-GCFMM_ALWAYS_INLINE void fill_negative_m(int nmax, double *Xr, double *Xi) {
+GCSIMD_ALWAYS_INLINE void fill_negative_m(int nmax, double *Xr, double *Xi) {
   for (int n = 1; n <= nmax; ++n)
     for (int m = 1; m <= n; ++m) {
       const double s = (m & 1) ? -1.0 : 1.0;
@@ -119,7 +119,7 @@ GCFMM_ALWAYS_INLINE void fill_negative_m(int nmax, double *Xr, double *Xi) {
 // NF >= 0: the row n = NF is known at compile time, so the n+1 outputs of all lanes stay in
 // registers while (k, l) run over the sources; NF < 0: any row n <= kMaxOrder (high orders).
 template <int NF>
-GCFMM_ALWAYS_INLINE void m2l_row(int n, int p, const double *__restrict Mr, const double *__restrict Mi, const double *__restrict Tr,
+GCSIMD_ALWAYS_INLINE void m2l_row(int n, int p, const double *__restrict Mr, const double *__restrict Mi, const double *__restrict Tr,
              const double *__restrict Ti, double *__restrict Ar, double *__restrict Ai) {
   constexpr int W = kLanes;
   constexpr int kRows = NF >= 0 ? NF + 1 : kMaxOrder + 1;
@@ -150,7 +150,7 @@ GCFMM_ALWAYS_INLINE void m2l_row(int n, int p, const double *__restrict Mr, cons
 
 // all rows n = N..p: compile-time rows up to kMaxFixedRow, the runtime row beyond
 template <int N>
-GCFMM_ALWAYS_INLINE void m2l_rows(int p, const double *Mr, const double *Mi, const double *Tr, const double *Ti, double *Ar,
+GCSIMD_ALWAYS_INLINE void m2l_rows(int p, const double *Mr, const double *Mi, const double *Tr, const double *Ti, double *Ar,
                      double *Ai) {
   if (N > p) return;
   m2l_row<N>(N, p, Mr, Mi, Tr, Ti, Ar, Ai);
@@ -162,7 +162,7 @@ GCFMM_ALWAYS_INLINE void m2l_rows(int p, const double *Mr, const double *Mi, con
 
 // coordinates of the points [j0, j0 + kLanes) relative to c, and the number of lanes in use;
 // lanes past np get the point 0 (harmless for regular harmonics)
-GCFMM_ALWAYS_INLINE int gather_lanes(std::size_t j0, std::size_t np, const double *x, const double *y, const double *z,
+GCSIMD_ALWAYS_INLINE int gather_lanes(std::size_t j0, std::size_t np, const double *x, const double *y, const double *z,
                         const Vec3 &c, double *dx, double *dy, double *dz) {
   const int nl = static_cast<int>(std::min<std::size_t>(kLanes, np - j0));
   for (int v = 0; v < kLanes; ++v) {
@@ -176,7 +176,7 @@ GCFMM_ALWAYS_INLINE int gather_lanes(std::size_t j0, std::size_t np, const doubl
 
 using detail::LaneState;
 
-GCFMM_ALWAYS_INLINE void p2m_batch_body(const LaneState &st, std::size_t np, const double *x, const double *y, const double *z, const double *q,
+GCSIMD_ALWAYS_INLINE void p2m_batch_body(const LaneState &st, std::size_t np, const double *x, const double *y, const double *z, const double *q,
                           const Vec3 &c, double *M) {
   constexpr int W = kLanes;
   const int p = st.p, S = st.S;
@@ -211,7 +211,7 @@ GCFMM_ALWAYS_INLINE void p2m_batch_body(const LaneState &st, std::size_t np, con
     }
 }
 
-GCFMM_ALWAYS_INLINE void l2p_batch_body(const LaneState &st, const double *L, const Vec3 &c, std::size_t np, const double *x, const double *y,
+GCSIMD_ALWAYS_INLINE void l2p_batch_body(const LaneState &st, const double *L, const Vec3 &c, std::size_t np, const double *x, const double *y,
                           const double *z, double *pot, double *ex, double *ey, double *ez) {
   constexpr int W = kLanes;
   const int p = st.p, S = st.S;
@@ -260,7 +260,7 @@ GCFMM_ALWAYS_INLINE void l2p_batch_body(const LaneState &st, const double *L, co
   }
 }
 
-GCFMM_ALWAYS_INLINE void m2l_batch_body(const LaneState &st, std::size_t count, const double *const *Ms, const Vec3 *R, double *Lt) {
+GCSIMD_ALWAYS_INLINE void m2l_batch_body(const LaneState &st, std::size_t count, const double *const *Ms, const Vec3 *R, double *Lt) {
   constexpr int W = kLanes;
   const int p = st.p, S = st.S;
   double *__restrict Tr = st.harm, *__restrict Ti = st.harm + S * W;
@@ -307,7 +307,7 @@ GCFMM_ALWAYS_INLINE void m2l_batch_body(const LaneState &st, std::size_t count, 
   }
 }
 
-GCFMM_ALWAYS_INLINE void m2p_batch_body(const LaneState &st, const double *M, const Vec3 &c, std::size_t np,
+GCSIMD_ALWAYS_INLINE void m2p_batch_body(const LaneState &st, const double *M, const Vec3 &c, std::size_t np,
                                        const double *x, const double *y, const double *z, double *pot, double *ex,
                                        double *ey, double *ez) {
   constexpr int W = kLanes;
@@ -349,30 +349,30 @@ GCFMM_ALWAYS_INLINE void m2p_batch_body(const LaneState &st, const double *M, co
   }
 }
 
-// each batched operator compiled for every instruction-set path (src/simd_paths.hpp)
-GCFMM_DEFINE_SIMD_PATHS(void, m2p_batch_path,
+// each batched operator compiled for every instruction-set path (gcsimd/simd_paths.hpp)
+GCSIMD_DEFINE_PATHS(void, m2p_batch_path,
                         (const LaneState &st, const double *M, const Vec3 &c, std::size_t np, const double *x,
                          const double *y, const double *z, double *pot, double *ex, double *ey, double *ez),
                         m2p_batch_body, (st, M, c, np, x, y, z, pot, ex, ey, ez))
-GCFMM_DEFINE_SIMD_PATHS(void, p2m_batch_path,
+GCSIMD_DEFINE_PATHS(void, p2m_batch_path,
                         (const LaneState &st, std::size_t np, const double *x, const double *y, const double *z,
                          const double *q, const Vec3 &c, double *M),
                         p2m_batch_body, (st, np, x, y, z, q, c, M))
-GCFMM_DEFINE_SIMD_PATHS(void, l2p_batch_path,
+GCSIMD_DEFINE_PATHS(void, l2p_batch_path,
                         (const LaneState &st, const double *L, const Vec3 &c, std::size_t np, const double *x,
                          const double *y, const double *z, double *pot, double *ex, double *ey, double *ez),
                         l2p_batch_body, (st, L, c, np, x, y, z, pot, ex, ey, ez))
-GCFMM_DEFINE_SIMD_PATHS(void, m2l_batch_path,
+GCSIMD_DEFINE_PATHS(void, m2l_batch_path,
                         (const LaneState &st, std::size_t count, const double *const *Ms, const Vec3 *R,
                          double *Lt),
                         m2l_batch_body, (st, count, Ms, R, Lt))
 
 }  // namespace
 
-Operators::Operators(int order, SimdPath path) : p_(order), S_((order + 1) * (order + 1)), path_(path) {
+Operators::Operators(int order, gcsimd::SimdPath path) : p_(order), S_((order + 1) * (order + 1)), path_(path) {
   if (order < 1) throw std::invalid_argument("gcfmm: expansion order must be >= 1");
-  if (!simd_path_available(path))
-    throw std::invalid_argument(std::string("gcfmm: SIMD path ") + simd_path_name(path) + " not available");
+  if (!gcsimd::simd_path_available(path))
+    throw std::invalid_argument(std::string("gcfmm: SIMD path ") + gcsimd::simd_path_name(path) + " not available");
   if (order > kMaxOrder)
     throw std::invalid_argument("gcfmm: expansion order must be <= " + std::to_string(kMaxOrder));
   inv_nm_.assign(static_cast<std::size_t>((p_ + 1) * (p_ + 1)), 0.0);
@@ -485,78 +485,6 @@ void Operators::l2l(const double *Lp, const Vec3 &b, double *Lc) {
       cr[idx(n, m)] += ar;
       ci[idx(n, m)] += ai;
     }
-}
-
-void Operators::p2m_dipoles(std::size_t np, const double *x, const double *y, const double *z, const double *px,
-                            const double *py, const double *pz, const Vec3 &c, double *M) {
-  double *yr = harm_re_.data(), *yi = harm_im_.data();
-  double *mr = M, *mi = M + S_;
-  for (std::size_t j = 0; j < np; ++j) {
-    regular(Vec3{x[j] - c.x, y[j] - c.y, z[j] - c.z}, p_ - 1, yr, yi);
-    // Y_1^l(p): l = -1, 0, 1 (eq. (3.2), (3.4))
-    const double y1r[3] = {0.5 * px[j], pz[j], -0.5 * px[j]};
-    const double y1i[3] = {-0.5 * py[j], 0.0, -0.5 * py[j]};
-    // eq. (5.1): M_n^m += conj(sum_l Y_{n-1}^{m-l}(d) Y_1^l(p))
-    for (int n = 1; n <= p_; ++n)
-      for (int m = 0; m <= n; ++m) {
-        double ar = 0.0, ai = 0.0;
-        for (int l = -1; l <= 1; ++l) {
-          const int k = m - l;
-          if (k < -(n - 1) || k > n - 1) continue;
-          const double Ar = yr[idx(n - 1, k)], Ai = yi[idx(n - 1, k)];
-          ar += Ar * y1r[l + 1] - Ai * y1i[l + 1];
-          ai += Ar * y1i[l + 1] + Ai * y1r[l + 1];
-        }
-        mr[idx(n, m)] += ar;
-        mi[idx(n, m)] -= ai;
-      }
-  }
-}
-
-void Operators::l2p_gradient(const double *L, const Vec3 &r, double &pot, double &ex, double &ey, double &ez,
-                             double *g6) {
-  double *yr = harm_re_.data(), *yi = harm_im_.data();
-  regular(r, p_, yr, yi);
-  const double *pr = L, *pi = L + S_;
-  // eq. (3.12) for n <= 2 only: L'_n^m = sum_{k<=p-n,l} L_{n+k}^{m+l} conj(Y_k^l(r))
-  double cr[9] = {}, ci[9] = {};
-  for (int n = 0; n <= std::min(2, p_); ++n)
-    for (int m = 0; m <= n; ++m) {
-      double ar = 0.0, ai = 0.0;
-      for (int k = 0; k <= p_ - n; ++k)
-        for (int l = -k; l <= k; ++l) {
-          if (m + l < -(n + k) || m + l > n + k) continue;
-          const double Ar = pr[idx(n + k, m + l)], Ai = pi[idx(n + k, m + l)];
-          const double Yr = yr[idx(k, l)], Yi = yi[idx(k, l)];
-          ar += Ar * Yr + Ai * Yi;
-          ai += Ai * Yr - Ar * Yi;
-        }
-      cr[idx(n, m)] = ar;
-      ci[idx(n, m)] = ai;
-    }
-  pot += cr[idx(0, 0)];
-  ex += cr[idx(1, 1)];
-  ey += ci[idx(1, 1)];
-  ez -= cr[idx(1, 0)];
-  if (p_ < 2) return;
-  // eq. (5.2): Hessian H of phi from the degree-2 terms, G = -H
-  const double l20 = cr[idx(2, 0)], a1 = cr[idx(2, 1)], b1 = ci[idx(2, 1)], a2 = cr[idx(2, 2)],
-               b2 = ci[idx(2, 2)];
-  g6[0] -= -0.5 * l20 + 0.5 * a2;  // xx
-  g6[1] -= 0.5 * b2;               // xy
-  g6[2] -= -a1;                    // xz
-  g6[3] -= -0.5 * l20 - 0.5 * a2;  // yy
-  g6[4] -= -b1;                    // yz
-  g6[5] -= l20;                    // zz
-}
-
-double Operators::m2p_potential(const double *M, const Vec3 &r) {
-  double *tr = harm_re_.data(), *ti = harm_im_.data();
-  irregular(r, p_, tr, ti);
-  // eq. (3.8): phi = sum_{n,m} M_n^m T_n^m (real part)
-  double s = 0.0;
-  for (int i = 0; i < S_; ++i) s += M[i] * tr[i] - M[S_ + i] * ti[i];
-  return s;
 }
 
 }  // namespace gcfmm

@@ -8,9 +8,9 @@
 #include <string>
 
 #include "gcfmm/dipole_kernels.hpp"
-#include "gcfmm/simd_paths.hpp"
+#include "gcsimd/simd_paths.hpp"
 
-#if GCFMM_X86_DISPATCH
+#if GCSIMD_X86_DISPATCH
 #include <immintrin.h>
 #endif
 
@@ -22,7 +22,7 @@ namespace {
 // exact 1/sqrt, vectorised over the sources by the compiler (omp simd reduction). Its sums run
 // in another order than those of the x86 kernels (over sources, not over targets), so it is
 // the reference they are tested against (test_p2p), not an instance of their loop.
-GCFMM_ALWAYS_INLINE void p2p_loop(std::size_t nt, const double *__restrict xt, const double *__restrict yt,
+GCSIMD_ALWAYS_INLINE void p2p_loop(std::size_t nt, const double *__restrict xt, const double *__restrict yt,
                         const double *__restrict zt, std::size_t ns, const double *__restrict xs,
                         const double *__restrict ys, const double *__restrict zs, const double *__restrict qs,
                         double sx, double sy, double sz, double *__restrict pot, double *__restrict ex,
@@ -56,7 +56,7 @@ GCFMM_ALWAYS_INLINE void p2p_loop(std::size_t nt, const double *__restrict xt, c
 #define GCFMM_P2P_ARGS (nt, xt, yt, zt, ns, xs, ys, zs, qs, sx, sy, sz, pot, ex, ey, ez, r2_min)
 using p2p_loop_fn = void(*) GCFMM_P2P_PARAMS;
 
-#if GCFMM_X86_DISPATCH
+#if GCSIMD_X86_DISPATCH
 // The x86 kernels (AVX2, AVX-512): one loop, vectorised over the W targets of a register
 // (masked tail) with the sources broadcast one by one: no horizontal reductions, and each lane
 // (target) sees exactly the same sequence of operations wherever it sits, so a target's result
@@ -114,19 +114,19 @@ struct Avx512 {
   using V = __m512d;
   using Mask = __mmask8;
   static constexpr std::size_t kWidth = 8;
-  GCFMM_TARGET_AVX512 static Mask tail(std::size_t left) {
+  GCSIMD_TARGET_AVX512 static Mask tail(std::size_t left) {
     return left >= 8 ? static_cast<__mmask8>(0xFF) : static_cast<__mmask8>((1u << left) - 1u);
   }
-  GCFMM_TARGET_AVX512 static V set1(double v) { return _mm512_set1_pd(v); }
-  GCFMM_TARGET_AVX512 static V load(Mask m, const double *p) { return _mm512_maskz_loadu_pd(m, p); }
-  GCFMM_TARGET_AVX512 static void add_store(Mask m, double *p, V v) {
+  GCSIMD_TARGET_AVX512 static V set1(double v) { return _mm512_set1_pd(v); }
+  GCSIMD_TARGET_AVX512 static V load(Mask m, const double *p) { return _mm512_maskz_loadu_pd(m, p); }
+  GCSIMD_TARGET_AVX512 static void add_store(Mask m, double *p, V v) {
     _mm512_mask_storeu_pd(p, m, _mm512_add_pd(_mm512_maskz_loadu_pd(m, p), v));
   }
-  GCFMM_TARGET_AVX512 static V add(V a, V b) { return _mm512_add_pd(a, b); }
-  GCFMM_TARGET_AVX512 static V sub(V a, V b) { return _mm512_sub_pd(a, b); }
-  GCFMM_TARGET_AVX512 static V mul(V a, V b) { return _mm512_mul_pd(a, b); }
-  GCFMM_TARGET_AVX512 static V fmadd(V a, V b, V c) { return _mm512_fmadd_pd(a, b, c); }
-  GCFMM_TARGET_AVX512 static V rsqrt(V r2, V rmin2) {
+  GCSIMD_TARGET_AVX512 static V add(V a, V b) { return _mm512_add_pd(a, b); }
+  GCSIMD_TARGET_AVX512 static V sub(V a, V b) { return _mm512_sub_pd(a, b); }
+  GCSIMD_TARGET_AVX512 static V mul(V a, V b) { return _mm512_mul_pd(a, b); }
+  GCSIMD_TARGET_AVX512 static V fmadd(V a, V b, V c) { return _mm512_fmadd_pd(a, b, c); }
+  GCSIMD_TARGET_AVX512 static V rsqrt(V r2, V rmin2) {
     const __m512d half = _mm512_set1_pd(0.5), three_half = _mm512_set1_pd(1.5);
     const __mmask8 keep = _mm512_cmp_pd_mask(r2, rmin2, _CMP_GT_OQ);
     __m512d y = _mm512_maskz_rsqrt14_pd(keep, r2);
@@ -145,20 +145,20 @@ struct Avx2 {
   using V = __m256d;
   using Mask = __m256i;
   static constexpr std::size_t kWidth = 4;
-  GCFMM_TARGET_AVX2 static Mask tail(std::size_t left) {
+  GCSIMD_TARGET_AVX2 static Mask tail(std::size_t left) {
     const long long all = -1;
     return _mm256_set_epi64x(left > 3 ? all : 0, left > 2 ? all : 0, left > 1 ? all : 0, all);
   }
-  GCFMM_TARGET_AVX2 static V set1(double v) { return _mm256_set1_pd(v); }
-  GCFMM_TARGET_AVX2 static V load(Mask m, const double *p) { return _mm256_maskload_pd(p, m); }
-  GCFMM_TARGET_AVX2 static void add_store(Mask m, double *p, V v) {
+  GCSIMD_TARGET_AVX2 static V set1(double v) { return _mm256_set1_pd(v); }
+  GCSIMD_TARGET_AVX2 static V load(Mask m, const double *p) { return _mm256_maskload_pd(p, m); }
+  GCSIMD_TARGET_AVX2 static void add_store(Mask m, double *p, V v) {
     _mm256_maskstore_pd(p, m, _mm256_add_pd(_mm256_maskload_pd(p, m), v));
   }
-  GCFMM_TARGET_AVX2 static V add(V a, V b) { return _mm256_add_pd(a, b); }
-  GCFMM_TARGET_AVX2 static V sub(V a, V b) { return _mm256_sub_pd(a, b); }
-  GCFMM_TARGET_AVX2 static V mul(V a, V b) { return _mm256_mul_pd(a, b); }
-  GCFMM_TARGET_AVX2 static V fmadd(V a, V b, V c) { return _mm256_fmadd_pd(a, b, c); }
-  GCFMM_TARGET_AVX2 static V rsqrt(V r2, V rmin2) {
+  GCSIMD_TARGET_AVX2 static V add(V a, V b) { return _mm256_add_pd(a, b); }
+  GCSIMD_TARGET_AVX2 static V sub(V a, V b) { return _mm256_sub_pd(a, b); }
+  GCSIMD_TARGET_AVX2 static V mul(V a, V b) { return _mm256_mul_pd(a, b); }
+  GCSIMD_TARGET_AVX2 static V fmadd(V a, V b, V c) { return _mm256_fmadd_pd(a, b, c); }
+  GCSIMD_TARGET_AVX2 static V rsqrt(V r2, V rmin2) {
     const __m256d half = _mm256_set1_pd(0.5), three_half = _mm256_set1_pd(1.5);
     const __m256d lo = _mm256_set1_pd(1e-36), hi = _mm256_set1_pd(1e36), one = _mm256_set1_pd(1.0);
     const __m256d keep = _mm256_cmp_pd(r2, rmin2, _CMP_GT_OQ);
@@ -174,10 +174,10 @@ struct Avx2 {
 };
 #undef GCFMM_NEWTON
 
-__attribute__((flatten)) GCFMM_TARGET_AVX512 void p2p_rsqrt_avx512 GCFMM_P2P_PARAMS {
+__attribute__((flatten)) GCSIMD_TARGET_AVX512 void p2p_rsqrt_avx512 GCFMM_P2P_PARAMS {
   p2p_rsqrt<Avx512> GCFMM_P2P_ARGS;
 }
-__attribute__((flatten)) GCFMM_TARGET_AVX2 void p2p_rsqrt_avx2 GCFMM_P2P_PARAMS {
+__attribute__((flatten)) GCSIMD_TARGET_AVX2 void p2p_rsqrt_avx2 GCFMM_P2P_PARAMS {
   p2p_rsqrt<Avx2> GCFMM_P2P_ARGS;
 }
 #pragma GCC diagnostic pop
@@ -187,10 +187,10 @@ __attribute__((flatten)) GCFMM_TARGET_AVX2 void p2p_rsqrt_avx2 GCFMM_P2P_PARAMS 
 void p2p_loop_generic GCFMM_P2P_PARAMS { p2p_loop GCFMM_P2P_ARGS; }
 
 // the P2P kernel of a path: the loop for Generic, the rsqrt kernels for AVX2 and AVX-512
-p2p_loop_fn p2p_kernel(SimdPath path) {
-#if GCFMM_X86_DISPATCH
-  if (path == SimdPath::AVX512) return p2p_rsqrt_avx512;
-  if (path == SimdPath::AVX2) return p2p_rsqrt_avx2;
+p2p_loop_fn p2p_kernel(gcsimd::SimdPath path) {
+#if GCSIMD_X86_DISPATCH
+  if (path == gcsimd::SimdPath::AVX512) return p2p_rsqrt_avx512;
+  if (path == gcsimd::SimdPath::AVX2) return p2p_rsqrt_avx2;
 #endif
   (void) path;
   return p2p_loop_generic;
@@ -198,18 +198,18 @@ p2p_loop_fn p2p_kernel(SimdPath path) {
 
 }  // namespace
 
-void p2p_with(SimdPath path, std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
+void p2p_with(gcsimd::SimdPath path, std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
               const double *xs, const double *ys, const double *zs, const double *qs, double sx, double sy, double sz,
               double *pot, double *ex, double *ey, double *ez, double r2_min) {
-  if (!simd_path_available(path))
-    throw std::invalid_argument(std::string("gcfmm: SIMD path ") + simd_path_name(path) + " not available");
+  if (!gcsimd::simd_path_available(path))
+    throw std::invalid_argument(std::string("gcfmm: SIMD path ") + gcsimd::simd_path_name(path) + " not available");
   p2p_kernel(path) GCFMM_P2P_ARGS;
 }
 
 void p2p(std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns, const double *xs,
          const double *ys, const double *zs, const double *qs, double sx, double sy, double sz, double *pot,
          double *ex, double *ey, double *ez, double r2_min) {
-  static const p2p_loop_fn kernel = p2p_kernel(default_simd_path());
+  static const p2p_loop_fn kernel = p2p_kernel(gcsimd::default_simd_path());
   kernel GCFMM_P2P_ARGS;
 }
 
@@ -286,7 +286,7 @@ inline void p2p_dipoles_loop GCFMM_P2PD_PARAMS {
   }
 }
 
-#if GCFMM_X86_DISPATCH
+#if GCSIMD_X86_DISPATCH
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 // FieldTerms<__m512d>: the register types' may_alias attribute does not carry into the template
@@ -347,19 +347,19 @@ void p2p_dipoles_generic(std::size_t nt, const double *xt, const double *yt, con
                          double *ex, double *ey, double *ez, double *g6, double r2_min, bool charges, bool dipoles) {
   GCFMM_P2PD_CHOOSE(GCFMM_P2PD_GENERIC)
 }
-#if GCFMM_X86_DISPATCH
+#if GCSIMD_X86_DISPATCH
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 #define GCFMM_P2PD_AVX512(C, D, G) p2p_dipoles_rsqrt<Avx512, C, D, G> GCFMM_P2PD_ARGS
 #define GCFMM_P2PD_AVX2(C, D, G) p2p_dipoles_rsqrt<Avx2, C, D, G> GCFMM_P2PD_ARGS
-__attribute__((flatten)) GCFMM_TARGET_AVX512 void p2p_dipoles_avx512(
+__attribute__((flatten)) GCSIMD_TARGET_AVX512 void p2p_dipoles_avx512(
     std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns, const double *xs,
     const double *ys, const double *zs, const double *qs, const double *pxs, const double *pys, const double *pzs,
     double sx, double sy, double sz, double *pot, double *ex, double *ey, double *ez, double *g6, double r2_min,
     bool charges, bool dipoles) {
   GCFMM_P2PD_CHOOSE(GCFMM_P2PD_AVX512)
 }
-__attribute__((flatten)) GCFMM_TARGET_AVX2 void p2p_dipoles_avx2(
+__attribute__((flatten)) GCSIMD_TARGET_AVX2 void p2p_dipoles_avx2(
     std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns, const double *xs,
     const double *ys, const double *zs, const double *qs, const double *pxs, const double *pys, const double *pzs,
     double sx, double sy, double sz, double *pot, double *ex, double *ey, double *ez, double *g6, double r2_min,
@@ -390,10 +390,10 @@ void p2p_dipoles(std::size_t nt, const double *xt, const double *yt, const doubl
                          const double *, double, double, double, double *, double *, double *, double *, double *,
                          double, bool, bool);
   static const Kernel kernel = [] {
-#if GCFMM_X86_DISPATCH
-    const SimdPath p = default_simd_path();
-    if (p == SimdPath::AVX512) return static_cast<Kernel>(p2p_dipoles_avx512);
-    if (p == SimdPath::AVX2) return static_cast<Kernel>(p2p_dipoles_avx2);
+#if GCSIMD_X86_DISPATCH
+    const gcsimd::SimdPath p = gcsimd::default_simd_path();
+    if (p == gcsimd::SimdPath::AVX512) return static_cast<Kernel>(p2p_dipoles_avx512);
+    if (p == gcsimd::SimdPath::AVX2) return static_cast<Kernel>(p2p_dipoles_avx2);
 #endif
     return static_cast<Kernel>(p2p_dipoles_generic);
   }();

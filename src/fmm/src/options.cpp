@@ -41,10 +41,8 @@ void Options::validate() const {
 // Calibrated model of the relative RMS force error (doc/theory.md, eq. (3.15)):
 //   err(p, theta) = 1.2 theta^(p+1) / (p+1)^2
 // The prefactor bounds the measurements on random free-space charges, on the 3 x 3 image block
-// and on the deposition geometry (calibration tables: doc/fmm-accuracy.md). It was 0.6 for
-// p >= 4 (and 1.2 below): 4000 random charges in free space measured 1.02e-4 at p = 8, theta
-// 0.6, where 0.6 predicted 7.5e-5, and 1500 charges in the image block 1.22e-6 at p = 15
-// (predicted 6.6e-7): a request of 1e-4 or 1e-6 was not delivered.
+// and on the deposition geometry (calibration tables: doc/fmm-accuracy.md), so that a requested
+// accuracy is delivered at every order: a smaller one under-predicts the error at high orders.
 double predicted_error(int order, double theta) {
   const double q = order + 1.0;
   return 1.2 * std::pow(theta, q) / (q * q);

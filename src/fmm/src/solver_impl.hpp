@@ -46,8 +46,8 @@ inline double timed(F &&f) {
 // doc/benchmarks.md.
 // The M2L coefficient depends on the instruction-set path: the AVX-512 P2P is the fastest
 // relative to M2L (doc/benchmarks.md, "Cost model per path").
-inline double m2l_cost(int p, SimdPath path) {
-  const double c = path == SimdPath::AVX512 ? 0.8 : (path == SimdPath::AVX2 ? 0.4 : 0.2);
+inline double m2l_cost(int p, gcsimd::SimdPath path) {
+  const double c = path == gcsimd::SimdPath::AVX512 ? 0.8 : (path == gcsimd::SimdPath::AVX2 ? 0.4 : 0.2);
   return c * (p + 1.0) * (p + 1.0) * (p + 1.0);
 }
 inline double l2p_cost(int p) { return 0.25 * (p + 1.0) * (p + 1.0); }

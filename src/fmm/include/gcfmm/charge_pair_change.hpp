@@ -11,7 +11,7 @@
 
 #include <cstddef>
 
-#include "gcfmm/simd.hpp"
+#include "gcsimd/simd.hpp"
 
 namespace gcfmm {
 
@@ -32,7 +32,7 @@ struct ChargePairChange {
  *  (its end contributes 0). r2now[k] = |now_k|^2, r2then[k] = |then_k|^2. Output arrays must
  *  not overlap the inputs. */
 void charge_pair_change(std::size_t n, Separations now, Separations then, ChargePairChange out,
-                        SimdPath path = default_simd_path());
+                        gcsimd::SimdPath path = gcsimd::default_simd_path());
 
 }  // namespace gcfmm
 

@@ -14,7 +14,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "gcfmm/simd.hpp"
+#include "gcsimd/simd.hpp"
 #include "gcfmm/types.hpp"
 
 namespace gcfmm {
@@ -34,13 +34,15 @@ struct LaneState;
 class Operators {
  public:
   /** @param order expansion order p, 1 <= p <= kMaxOrder
-   *  @param path  instruction-set path of the batched operators (include/gcfmm/simd.hpp)
+   *  @param path  instruction-set path of the batched operators (gcsimd/simd.hpp, src/simd)
    *  @throws std::invalid_argument on a bad order or an unavailable path */
-  explicit Operators(int order, SimdPath path = default_simd_path());
+  explicit Operators(int order, gcsimd::SimdPath path = gcsimd::default_simd_path());
   int order() const { return p_; }
-  SimdPath simd_path() const { return path_; }  //!< instruction-set path of the batched operators
+  gcsimd::SimdPath simd_path() const { return path_; }  //!< instruction-set path of the batched operators
   //! number of doubles of one expansion (2 (p+1)^2)
   std::size_t size() const { return 2 * static_cast<std::size_t>(S_); }
+  //! position of coefficient (n, m) in the full layout
+  static constexpr int index(int n, int m) { return n * n + n + m; }
 
   /** @brief Regular solid harmonics Y_n^m(r), n <= nmax (<= p), full layout of order nmax
    *  (doc/theory.md, eq. (3.2)). */
@@ -113,7 +115,7 @@ class Operators {
   detail::LaneState lanes();
   int p_;
   int S_;
-  SimdPath path_;
+  gcsimd::SimdPath path_;
   std::vector<double> inv_nm_;  //!< 1/((n+m)(n-m)) at [n*(p+1)+m] (regular recurrence)
   std::vector<double> nm1_;     //!< (n-1+m)(n-1-m) at [n*(p+1)+m] (irregular recurrence)
   std::vector<double> harm_re_, harm_im_;  //!< scratch: harmonics of one vector (M2M, L2L, M2P)

@@ -78,14 +78,12 @@ class PeriodicFarField {
   static constexpr int kMaxCompressedBlock = 256;
 
   //! Largest peak memory of a set-up (dense operator blocks, kernel table and node
-  //! differences, held at once before the blocks are compressed; setup_bytes() tracks the
-  //! measured peak RSS within 3%), per caller (each MPI rank of the LAMMPS fix holds a copy).
-  //! 1 GiB admits every tested column (H/L = 160 at accuracy 1e-4: 116 MB; H/L = 50 at 1e-6:
-  //! 287 MB; H/L = 160 at 1e-6: 0.9 GB, 3.3 s) and columns up to H/L ~ 1400 at the default
-  //! 1e-4 (H/L = 1000: 0.71 GB, 5.4 s), ~190 at 1e-6, ~1e4 at 1e-2; beyond, the cost grows
-  //! linearly with H (a column refused here: H/L = 1e5 at 1e-4 was killed by the
-  //! out-of-memory killer at 22.5 GB after 241 s). Then setup() throws FarFieldTooLarge
-  //! (doc/fmm-far-field.md, "Column height").
+  //! differences, held at once before the blocks are compressed; setup_bytes() estimates it),
+  //! per caller (each MPI rank of the LAMMPS fix holds a copy). The bound admits the columns
+  //! of a deposition at the accuracies it uses and refuses, with a message, the columns whose
+  //! set-up would exhaust a node's memory: the cost grows linearly with the column's height.
+  //! Then setup() throws FarFieldTooLarge (doc/fmm-far-field.md, "Column height", which has
+  //! the measured memory and time per height and accuracy).
   static constexpr double kMaxSetupBytes = 1024.0 * 1024 * 1024;
 
   /// @brief Estimated peak bytes of setup_explicit() for these parameters (what

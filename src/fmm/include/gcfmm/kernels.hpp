@@ -7,7 +7,7 @@
 
 #include <cstddef>
 
-#include "gcfmm/simd.hpp"
+#include "gcsimd/simd.hpp"
 
 namespace gcfmm {
 
@@ -22,8 +22,8 @@ void p2p(std::size_t nt, const double *xt, const double *yt, const double *zt, s
          double sz, double *pot, double *ex, double *ey, double *ez, double r2_min = 0.0);
 
 /** @brief p2p() on a given instruction-set path (tests and benchmarks; p2p() uses
- *  default_simd_path()). @throws std::invalid_argument if the path is not available. */
-void p2p_with(SimdPath path, std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
+ *  gcsimd::default_simd_path()). @throws std::invalid_argument if the path is not available. */
+void p2p_with(gcsimd::SimdPath path, std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
               const double *xs, const double *ys, const double *zs, const double *qs, double sx, double sy, double sz,
               double *pot, double *ex, double *ey, double *ez, double r2_min = 0.0);
 

@@ -37,15 +37,14 @@ struct PolarizableOutputs {
 class PolarizableSolver {
  public:
   /** @param dipoles whether compute() will be given polarizabilities. Their forces G p need the
-   *  field gradient, whose error at a given expansion order is larger than the field's (forces
-   *  measured at ~5.4 x the request in the deposition geometry, doc/benchmarks.md "Induced
-   *  dipoles"): the expansions are then chosen for Options::accuracy divided by
-   *  dipole_accuracy_margin() (an order given explicitly is kept). */
+   *  field gradient, whose error at a given expansion order is larger than the field's
+   *  (doc/benchmarks.md, "Induced dipoles"): the expansions are then chosen for
+   *  Options::accuracy divided by dipole_accuracy_margin() (an order given explicitly is
+   *  kept). */
   explicit PolarizableSolver(const Options &opts, bool dipoles = true);
   /** @brief The calibrated factor by which the expansions' accuracy is tightened for dipoles at
-   *  a requested accuracy: 8 down to 1e-5 (measured forces 0.53 and 0.70 of the request at 1e-3
-   *  and 1e-4), 16 below (at 1e-6 a factor 8 gave 1.01 x, 16 gave 0.54 x: the exact far field's
-   *  gradient). */
+   *  a requested accuracy (doc/benchmarks.md, "Induced dipoles"): 8 down to 1e-5, 16 below,
+   *  where the exact far field's gradient needs the tighter margin to deliver the request. */
   static double dipole_accuracy_margin(double accuracy) { return accuracy >= 1e-5 ? 8.0 : 16.0; }
   /** @brief Periodic2D: the primary cell (Solver::set_box). */
   void set_box(double xlo, double ylo, double lx, double ly);

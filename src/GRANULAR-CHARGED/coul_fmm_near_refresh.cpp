@@ -7,7 +7,9 @@
    the GNU General Public License (same terms as LAMMPS).
 ------------------------------------------------------------------------- */
 
-#include "coul_fmm_near.h"
+#include "coul_fmm_near_refresh.h"
+
+#include "coul_fmm_state.h"
 
 #include "coul_fmm_time_stepping.h"
 
@@ -31,7 +33,7 @@ using MTS = CoulFMMTimeStepping;
 CoulFMMNearRefresh::CoulFMMNearRefresh(LAMMPS *lmp, Fix *owner) :
     Pointers(lmp), fix(owner), list(nullptr), delta(nullptr), near_now(nullptr), near_then(nullptr),
     nmax_delta(0), nmax_out(0), pair_now{}, pair_then{}, pair_dg{}, pair_r2now(nullptr),
-    pair_r2then(nullptr), simd_path(gcfmm::default_simd_path())
+    pair_r2then(nullptr), simd_path(gcsimd::default_simd_path())
 {
 }
 
@@ -55,7 +57,7 @@ void CoulFMMNearRefresh::request(double cutoff)
   }
 }
 
-void CoulFMMNearRefresh::compute(const MTS &scheme, double **eval_state, bool into_then,
+void CoulFMMNearRefresh::compute(const MTS &scheme, const CoulFMMState &state, bool into_then,
                                  double trend)
 {
   const int nlocal = atom->nlocal, nall = nlocal + atom->nghost;
@@ -77,7 +79,7 @@ void CoulFMMNearRefresh::compute(const MTS &scheme, double **eval_state, bool in
   double xu[3];
   for (int i = 0; i < nlocal; i++) {
     domain->unmap(x[i], atom->image[i], xu);
-    MTS::displacements(xu, eval_state[i], delta[i]);
+    MTS::displacements(xu, state.evaluation(i), delta[i]);
   }
   comm->forward_comm(fix);
   for (int i = 0; i < nlocal; i++)

@@ -12,12 +12,12 @@
 // (forward-communicated to the ghosts through the fix) and the sum over the pairs; the pair
 // formula itself is CoulFMMTimeStepping::near_pair_change.
 
-#ifndef LMP_COUL_FMM_NEAR_H
-#define LMP_COUL_FMM_NEAR_H
+#ifndef LMP_COUL_FMM_NEAR_REFRESH_H
+#define LMP_COUL_FMM_NEAR_REFRESH_H
 
 #include "pointers.h"
 
-#include "gcfmm/simd.hpp"
+#include "gcsimd/simd.hpp"
 
 #include <utility>
 #include <vector>
@@ -37,7 +37,8 @@ class CoulFMMNearRefresh : protected Pointers {
 
   // C sum_j q_j (change of (K, 1/r) of pair ij since the evaluation) for the local atoms of the
   // group into now() (trend >= 0: between evaluations) or then() (trend < 0: the D of a slope)
-  void compute(const CoulFMMTimeStepping &scheme, double **eval_state, bool into_then, double trend);
+  void compute(const CoulFMMTimeStepping &scheme, const class CoulFMMState &state, bool into_then,
+               double trend);
   double **now() const { return near_now; }
   double **then() const { return near_then; }
 
@@ -57,7 +58,7 @@ class CoulFMMNearRefresh : protected Pointers {
   double *pair_now[3], *pair_then[3], *pair_dg[4], *pair_r2now, *pair_r2then;
   std::vector<int> pair_j;                      // the pairs' second atoms
   std::vector<std::pair<int, int>> pair_i;      // each first atom and the end of its pairs
-  gcfmm::SimdPath simd_path;
+  gcsimd::SimdPath simd_path;
   void grow_pairs(int n);
 };
 

@@ -1,19 +1,19 @@
-// GRANULAR-CHARGED FMM core library (gcfmm): choice of the instruction-set path
-// (include/gcfmm/simd.hpp).
-#include "gcfmm/simd.hpp"
+// GRANULAR-CHARGED shared SIMD layer (gcsimd): choice of the instruction-set path
+// (include/gcsimd/simd.hpp).
+#include "gcsimd/simd.hpp"
 
 #include <cstdlib>
 #include <cstring>
 
-#include "gcfmm/simd_paths.hpp"
+#include "gcsimd/simd_paths.hpp"
 
-namespace gcfmm {
+namespace gcsimd {
 
 bool simd_path_available(SimdPath path) {
   switch (path) {
     case SimdPath::Generic:
       return true;
-#if GCFMM_X86_DISPATCH
+#if GCSIMD_X86_DISPATCH
     case SimdPath::AVX2:
       return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
     case SimdPath::AVX512:
@@ -44,4 +44,4 @@ const char *simd_path_name(SimdPath path) {
   }
 }
 
-}  // namespace gcfmm
+}  // namespace gcsimd

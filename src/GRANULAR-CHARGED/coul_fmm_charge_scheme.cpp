@@ -1,0 +1,178 @@
+/* ----------------------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+#include "coul_fmm_charge_scheme.h"
+
+#include "coul_fmm_backend.h"
+#include "coul_fmm_evaluator.h"
+#include "coul_fmm_near_refresh.h"
+#include "coul_fmm_state.h"
+#include "coul_fmm_time_stepping.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "domain.h"
+#include "error.h"
+#include "fix.h"
+#include "modify.h"
+#include "update.h"
+
+#include "gcfmm/options.hpp"
+
+using namespace LAMMPS_NS;
+using MTS = CoulFMMTimeStepping;
+
+CoulFMMChargeScheme::CoulFMMChargeScheme(LAMMPS *lmp, const Parts &parts) :
+    Pointers(lmp), p(parts),
+    eval(std::make_unique<CoulFMMEvaluator>(lmp, parts.fix->id, parts.fix->groupbit, *parts.backend)),
+    nevaluations(0.0)
+{
+}
+
+CoulFMMChargeScheme::~CoulFMMChargeScheme() = default;
+
+void CoulFMMChargeScheme::init()
+{
+  auto sleep = modify->get_fix_by_style("^sleep/gran$");
+  eval->init(*p.opts, sleep.empty() || !p.sleepers_static ? nullptr : sleep[0],
+             p.fix->thermo_virial, p.distributed);
+  const auto &mts = p.stepping->settings();
+  if (mts.tolerance > 0.0 && comm->me == 0)
+    utils::logmesg(lmp,
+                   "Fix coul/fmm {}: evaluation interval adapted between 1 and {} steps to "
+                   "a time-stepping error of {:.3g}\n",
+                   p.fix->id, mts.every, mts.tolerance);
+  if (mts.near_cutoff > 0.0 && mts.every == 1 && comm->me == 0)
+    error->warning(FLERR,
+                   "Fix coul/fmm {}: near has no effect with every 1 (each step is an "
+                   "evaluation)",
+                   p.fix->id);
+  if (p.stepping->refreshes_near()) p.near->request(mts.near_cutoff);
+}
+
+// continue the schedule of the previous run (or of the restart file) when its stored field
+// still belongs to these atoms, charges and box: a run split into pieces, or continued from a
+// restart, then evaluates on the same steps as the uninterrupted run
+bool CoulFMMChargeScheme::continues()
+{
+  eval->update_sleepers();
+  return p.state->continues(*p.stepping, eval->boundary(), [this](int i) { return eval->asleep(i); });
+}
+
+// evaluate on the schedule's steps, whenever atoms were added or removed (fix deposit,
+// evaporate: a new atom must feel, and exert, the force from its first step) and whenever the
+// charges, qqrd2e or the geometry changed (a stored field would belong to other charges); a
+// line search evaluates several trial positions within one step: always (predict false)
+double CoulFMMChargeScheme::compute(bool predict)
+{
+  if (!predict) {
+    compute_field(false);
+    return apply_field();
+  }
+  const bigint step = update->ntimestep;
+  eval->update_sleepers();
+  const bool due = p.stepping->scheduled(step) ||
+      p.state->continuity(*p.stepping, eval->boundary(), [this](int i) { return eval->asleep(i); }) !=
+          MTS::Continuity::SAME;
+  if (due)
+    compute_field(true);
+  else if (p.stepping->settings().every > 1)
+    advance_field();
+  const int check = p.stepping->settings().check_every;
+  if (check > 0 && !due && step % check == 0) eval->measure_error(*p.stepping, *p.state);
+  return apply_field();
+}
+
+// a full evaluation (doc/theory.md, eqs. (5.2)-(5.4)); with the same atoms as at the last one
+// it first measures the error the time stepping had reached (CoulFMMTimeStepping::plan)
+void CoulFMMChargeScheme::compute_field(bool with_slope)
+{
+  CoulFMMState &st = *p.state;
+  CoulFMMTimeStepping &mts = *p.stepping;
+  const int nlocal = atom->nlocal;
+  eval->update_sleepers();
+  auto asleep_now = [this](int i) { return eval->asleep(i); };
+  const auto cont = with_slope && mts.settings().every > 1
+      ? st.continuity(mts, eval->boundary(), asleep_now)
+      : MTS::Continuity::NONE;
+  const MTS::Plan plan = mts.plan(cont, with_slope, update->ntimestep);
+  // the refresh the time stepping would have applied now, and D for a new slope
+  if (plan.near) {
+    p.near->compute(mts, st, false, plan.keep_slope ? mts.trend_factor(plan.steps) : 0.0);
+    if (plan.new_slope) p.near->compute(mts, st, true, -1.0);
+  }
+  const int groupbit = p.fix->groupbit;
+  for (int i = 0; i < nlocal; i++) {
+    double xu[3];
+    domain->unmap(atom->x[i], atom->image[i], xu);
+    const double q = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
+    mts.begin_evaluation(plan, st.evaluation(i), xu, q, eval->asleep(i),
+                         plan.near ? p.near->now()[i] : nullptr,
+                         plan.near ? p.near->then()[i] : nullptr, st.field(i));
+  }
+  st.record(mts, eval->boundary());
+  eval->evaluate([&st](int i) { return st.evaluated_field(i); }, true);
+  nevaluations += 1.0;
+  double sums[2] = {0.0, 0.0};
+  for (int i = 0; i < nlocal; i++) {
+    mts.end_evaluation(plan, st.evaluation(i), st.field(i), sums);
+    st.apply_evaluated(i);
+  }
+  if (plan.same) p.backend->communication().sum(sums, 2);
+  mts.finish_evaluation(plan, MTS::relative_rms(sums));
+}
+
+// eq. (5.2) between evaluations
+void CoulFMMChargeScheme::advance_field()
+{
+  CoulFMMTimeStepping &mts = *p.stepping;
+  const double steps = (double) (update->ntimestep - mts.evaluated.step);
+  const bool refresh = mts.settings().near_cutoff > 0.0;
+  if (refresh) p.near->compute(mts, *p.state, false, mts.trend_factor(steps));
+  for (int i = 0; i < atom->nlocal; i++)
+    mts.predict(p.state->evaluation(i), steps, refresh ? p.near->now()[i] : nullptr,
+                p.state->field(i));
+}
+
+// F_i = q_i E_i into the state's forces; returns this rank's energy 1/2 sum q_i phi_i
+double CoulFMMChargeScheme::apply_field()
+{
+  double *q = atom->q;
+  double energy = 0.0;
+  for (int i = 0; i < atom->nlocal; i++) {
+    if (!acts_on(i)) continue;
+    const double *e = p.state->field(i);
+    double *f = p.state->force_on(i);
+    for (int k = 0; k < 3; k++) f[k] = q[i] * e[k];
+    energy += 0.5 * q[i] * e[3];
+  }
+  return energy;
+}
+
+bool CoulFMMChargeScheme::acts_on(int i) const
+{
+  return (atom->mask[i] & p.fix->groupbit) && atom->q[i] != 0.0;
+}
+
+// the static sleepers' pair energy with the awake charges and among themselves
+double CoulFMMChargeScheme::total_energy(double atoms)
+{
+  if (!eval->split_active()) return atoms;
+  return atoms + eval->sleeper_pair_energy() + eval->sleeper_source_energy();
+}
+
+const CoulFMMScheme::Diagnostics &CoulFMMChargeScheme::diagnostics() const
+{
+  return eval->diagnostics_of_last();
+}
+
+double CoulFMMChargeScheme::memory_usage() const
+{
+  return eval->memory_usage();
+}

@@ -1,0 +1,76 @@
+/* -*- c++ -*- ----------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+// What fix coul/fmm asks of its Coulomb computation, whatever it is: the charges with the
+// multiple time stepping (CoulFMMChargeScheme) or charges with an applied field, induced
+// dipoles and an electrode (CoulFMMPolarizable). The fix holds one and calls it on the LAMMPS
+// hooks; both write their fields and forces into the fix's CoulFMMState.
+
+#ifndef LMP_COUL_FMM_SCHEME_H
+#define LMP_COUL_FMM_SCHEME_H
+
+namespace gcfmm {
+struct Options;
+}    // namespace gcfmm
+
+namespace LAMMPS_NS {
+class CoulFMMBackend;
+class CoulFMMNearRefresh;
+class CoulFMMState;
+class CoulFMMTimeStepping;
+class Fix;
+
+class CoulFMMScheme {
+ public:
+  // the fix's parts a scheme works with (kept by the fix)
+  struct Parts {
+    Fix *fix;
+    const gcfmm::Options *opts;
+    CoulFMMTimeStepping *stepping;
+    CoulFMMState *state;
+    CoulFMMBackend *backend;
+    CoulFMMNearRefresh *near;
+    bool sleepers_static;    // keyword sleepers static
+    bool distributed;        // keyword solver distributed
+  };
+
+  // the solver's side of the last evaluation (the same on every rank): vector elements 1-4,
+  // 11-14 of doc/fix_coul_fmm.md, "Output"
+  struct Diagnostics {
+    double estimated_error = 0.0, theta = 0.0;
+    int order = 0, leaf = 0;
+    double m2l = 0.0, p2p = 0.0;      // interactions of all ranks together
+    double bytes_received = 0.0;      // largest over the ranks, all collectives of the evaluation
+    double solver_memory = 0.0;       // largest over the ranks
+    double charges = 0.0;             // charged atoms evaluated
+    int iterations = 0;               // induction iterations (polarize)
+    double residual = 0.0;            // induction residual (polarize)
+  };
+
+  virtual ~CoulFMMScheme() noexcept(false) = default;    // as Pointers, which schemes derive from
+  // checks of the settings against the other styles, and the solver (the fix's own checks done)
+  virtual void init() = 0;
+  // at a run's setup: the stored state continues (else the schedule starts again)
+  virtual bool continues() = 0;
+  // the forces of this step (CoulFMMState::force) and the fields; predict false: a minimizer's
+  // trial positions (a fresh evaluation, nothing continued). Returns this rank's energy.
+  virtual double compute(bool predict) = 0;
+  // atom i (local) receives a force
+  virtual bool acts_on(int i) const = 0;
+  // the energy of all atoms (the ranks' sums of compute()) plus what no atom's force carries
+  // (the static sleepers' pairs)
+  virtual double total_energy(double atoms) { return atoms; }
+  virtual const Diagnostics &diagnostics() const = 0;
+  virtual double evaluations() const = 0;
+  virtual double memory_usage() const = 0;
+};
+
+}    // namespace LAMMPS_NS
+
+#endif

@@ -1,0 +1,173 @@
+/* ----------------------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+#include "coul_fmm_state.h"
+
+#include "atom.h"
+#include "domain.h"
+#include "force.h"
+#include "update.h"
+
+#include "gcfmm/options.hpp"
+#include "memory.h"
+
+#include <algorithm>
+#include <cmath>
+
+using namespace LAMMPS_NS;
+using MTS = CoulFMMTimeStepping;
+
+CoulFMMState::CoulFMMState(LAMMPS *lmp, int cols, int bit) :
+    Pointers(lmp), field_cols(cols), groupbit(bit), applied(nullptr), applied_force(nullptr),
+    row(nullptr), mpi(lmp)
+{
+}
+
+CoulFMMState::~CoulFMMState()
+{
+  memory->destroy(applied);
+  memory->destroy(applied_force);
+  memory->destroy(row);
+}
+
+void CoulFMMState::grow(int nmax)
+{
+  memory->grow(applied, nmax, field_cols, "coul/fmm:field");
+  memory->grow(applied_force, nmax, 3, "coul/fmm:polar_force");
+  memory->grow(row, nmax, MTS::COLS, "coul/fmm:eval_state");
+}
+
+void CoulFMMState::copy(int i, int j)
+{
+  std::copy(applied[i], applied[i] + field_cols, applied[j]);
+  std::copy(row[i], row[i] + MTS::COLS, row[j]);
+}
+
+void CoulFMMState::clear(int i)
+{
+  std::fill(applied[i], applied[i] + field_cols, 0.0);
+  std::fill(row[i], row[i] + MTS::COLS, 0.0);
+}
+
+int CoulFMMState::pack_exchange(int i, double *buf) const
+{
+  std::copy(applied[i], applied[i] + field_cols, buf);
+  std::copy(row[i], row[i] + MTS::COLS, buf + field_cols);
+  return exchange_size();
+}
+
+int CoulFMMState::unpack_exchange(int i, const double *buf)
+{
+  std::copy(buf, buf + field_cols, applied[i]);
+  std::copy(buf + field_cols, buf + field_cols + MTS::COLS, row[i]);
+  return exchange_size();
+}
+
+// the count first (atom->extra is shared by the fixes), the applied field (4), the row
+int CoulFMMState::pack_restart(int i, double *buf) const
+{
+  buf[0] = restart_size();
+  std::copy(applied[i], applied[i] + 4, buf + 1);
+  std::copy(row[i], row[i] + MTS::COLS, buf + 5);
+  return restart_size();
+}
+
+// files written before the ASLEEP column hold COLS_V1 columns: the rest start at zero
+void CoulFMMState::unpack_restart(int i, const double *values)
+{
+  const int cols = std::min<int>(MTS::COLS, std::max<int>(MTS::COLS_V1, static_cast<int>(values[0]) - 5));
+  int m = 1;
+  for (int k = 0; k < 4; k++) applied[i][k] = values[m++];
+  for (int k = 4; k < field_cols; k++) applied[i][k] = 0.0;
+  for (int k = 0; k < MTS::COLS; k++) row[i][k] = k < cols ? values[m++] : 0.0;
+}
+
+double CoulFMMState::memory_usage() const
+{
+  return (field_cols + 3.0 + MTS::COLS) * atom->nmax * sizeof(double);
+}
+
+void CoulFMMState::apply_evaluated(int i)
+{
+  for (int k = 0; k < 4; k++) applied[i][k] = row[i][MTS::FIELD + k];
+}
+
+void CoulFMMState::remember_positions()
+{
+  for (int i = 0; i < atom->nlocal; i++)
+    domain->unmap(atom->x[i], atom->image[i], &row[i][MTS::LAST_X]);
+}
+
+/* ----------------------------------------------------------------------
+   the continuity record
+------------------------------------------------------------------------- */
+
+void CoulFMMState::cell(double box[4]) const
+{
+  box[0] = domain->boxlo[0];
+  box[1] = domain->boxlo[1];
+  box[2] = domain->xprd;
+  box[3] = domain->yprd;
+}
+
+void CoulFMMState::record(CoulFMMTimeStepping &scheme, int boundary)
+{
+  auto &then = scheme.evaluated;
+  then.charges = 0;
+  for (int i = 0; i < atom->nlocal; i++)
+    if (charge_then(i) != 0.0) then.charges += coul_fmm_charge_hash(atom->tag[i], charge_then(i));
+  mpi.sum(&then.charges, 1);
+  then.step = update->ntimestep;
+  then.qqrd2e = force->qqrd2e;
+  then.boundary = boundary;
+  cell(then.box);
+}
+
+/* ----------------------------------------------------------------------
+   SAME charges (same IDs, same values) in the same geometry and units, charges ADDED (fix
+   deposit; or static sources woken) with all those of the evaluation still there and
+   unchanged, or NONE. The sum of hashes is an integer sum (modulo 2^64): exact and the same
+   however the atoms are distributed.
+------------------------------------------------------------------------- */
+
+CoulFMMTimeStepping::Continuity CoulFMMState::continuity(const CoulFMMTimeStepping &scheme,
+                                                         int boundary, const Predicate &asleep_now)
+{
+  double box[4];
+  cell(box);
+  const bool periodic = boundary == static_cast<int>(gcfmm::Boundary::Periodic2D);
+  if (!scheme.same_setting(boundary, force->qqrd2e, box, periodic))
+    return MTS::Continuity::NONE;
+  uint64_t sums[4] = {0, 0, 0, 0};    // as CoulFMMTimeStepping::continuity() reads them
+  for (int i = 0; i < atom->nlocal; i++) {
+    const double q = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0, q_then = charge_then(i);
+    if (q_then != 0.0) sums[0] += coul_fmm_charge_hash(atom->tag[i], q_then);
+    if (q != q_then) sums[1]++;
+    if (q != q_then && q_then != 0.0) sums[2]++;
+    if (q != 0.0 && static_source_then(i) && !asleep_now(i)) sums[3]++;
+  }
+  mpi.sum(sums, 4);
+  return scheme.continuity(sums);
+}
+
+// unwrapping after a remap may differ in the last bits, hence a tolerance
+bool CoulFMMState::continues(const CoulFMMTimeStepping &scheme, int boundary,
+                             const Predicate &asleep_now)
+{
+  if (continuity(scheme, boundary, asleep_now) != MTS::Continuity::SAME) return false;
+  const double tol = 1e-12 * std::max({domain->xprd, domain->yprd, domain->zprd});
+  bool moved = false;
+  double xu[3];
+  for (int i = 0; i < atom->nlocal; i++) {
+    if (charge_then(i) == 0.0) continue;
+    domain->unmap(atom->x[i], atom->image[i], xu);
+    for (int k = 0; k < 3; k++) moved = moved || fabs(xu[k] - position_applied(i)[k]) > tol;
+  }
+  return !mpi.any(moved);
+}

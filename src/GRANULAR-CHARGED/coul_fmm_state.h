@@ -1,0 +1,87 @@
+/* -*- c++ -*- ----------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+// The per-atom state of fix coul/fmm and its one owner: the field applied to each atom (and,
+// with efield, polarize or electrode, the force), and the row of the last evaluation that the
+// multiple time stepping continues (CoulFMMTimeStepping::Column). It grows, copies, migrates
+// and restarts the columns; the fix, the time stepping, the near refresh and the evaluator use
+// it through the named accessors below.
+
+#ifndef LMP_COUL_FMM_STATE_H
+#define LMP_COUL_FMM_STATE_H
+
+#include "coul_fmm_comm.h"
+#include "coul_fmm_time_stepping.h"
+#include "pointers.h"
+
+#include <functional>
+
+namespace LAMMPS_NS {
+
+class CoulFMMState : protected Pointers {
+  using MTS = CoulFMMTimeStepping;
+
+ public:
+  // field_cols: 4 (Ex, Ey, Ez, phi) or 7 (and the induced dipole); groupbit: the fix's group
+  CoulFMMState(class LAMMPS *, int field_cols, int groupbit);
+  ~CoulFMMState() override;
+
+  // ---- the columns (Fix::grow_arrays and the other per-atom callbacks) ----
+  void grow(int nmax);
+  void copy(int i, int j);
+  void clear(int i);    // a created atom: no stored field, charge 0 at the "evaluation"
+  int exchange_size() const { return field_cols + MTS::COLS; }
+  int pack_exchange(int i, double *buf) const;
+  int unpack_exchange(int i, const double *buf);
+  static int restart_size() { return 5 + MTS::COLS; }
+  int pack_restart(int i, double *buf) const;
+  // the values of this fix in atom->extra[i], starting with their count
+  void unpack_restart(int i, const double *values);
+  double memory_usage() const;
+
+  // ---- named accessors ----
+  int columns() const { return field_cols; }
+  double *field(int i) { return applied[i]; }    // Ex, Ey, Ez, phi (, dipole) applied
+  double **field_rows() { return applied; }      // LAMMPS's per-atom output (array_atom)
+  double *force_on(int i) { return applied_force[i]; }    // the force applied to atom i
+  double **force_rows() { return applied_force; }
+  double *evaluation(int i) { return row[i]; }    // the CoulFMMTimeStepping row
+  const double *evaluation(int i) const { return row[i]; }
+  double *evaluated_field(int i) { return &row[i][MTS::FIELD]; }
+  double charge_then(int i) const { return row[i][MTS::Q]; }
+  bool static_source_then(int i) const { return row[i][MTS::ASLEEP] != 0.0; }
+  const double *position_applied(int i) const { return &row[i][MTS::LAST_X]; }
+  // the evaluated field becomes the applied one (the atoms' first field columns)
+  void apply_evaluated(int i);
+  // where the local atoms are now: a later run continues the stored field only from there
+  void remember_positions();
+
+  // ---- the continuity record: what the stored evaluation belongs to ----
+  // asleep_now(i): atom i is a static source now (fix sleep/gran with static sleepers)
+  using Predicate = std::function<bool(int)>;
+  // before an evaluation: the charges, step, Coulomb constant, boundary and cell it is of
+  void record(CoulFMMTimeStepping &scheme, int boundary);
+  // how the stored evaluation relates to the atoms now
+  CoulFMMTimeStepping::Continuity continuity(const CoulFMMTimeStepping &scheme, int boundary,
+                                             const Predicate &asleep_now);
+  // at the start of a run: the stored field belongs to the same atoms, charges and box, and no
+  // atom was moved since the field was last applied (displace_atoms, set)
+  bool continues(const CoulFMMTimeStepping &scheme, int boundary, const Predicate &asleep_now);
+
+ private:
+  int field_cols;
+  int groupbit;
+  double **applied, **applied_force, **row;
+  CoulFMMComm mpi;
+  void cell(double box[4]) const;
+};
+
+}    // namespace LAMMPS_NS
+
+#endif
