@@ -74,7 +74,7 @@ class DepositionParams:
         """A file-system friendly name, unique for the parameters: the swept ones always, the
         far field of a charged run, and every other one that differs from its default."""
         base = f"{series_name(self.rp, self.U0, self.gamma)}_q{self.q:g}_N{self.N}_s{self.seed}"
-        if self.q:
+        if self.q or (self.extra and self._population_charged()):
             base += f"_{self.farfield}"
         tags = {k: getattr(self, k) for k in MATERIAL
                 if k != "farfield" and getattr(self, k) != getattr(DepositionParams, k)}
@@ -82,7 +82,12 @@ class DepositionParams:
         for k in sorted(tags):
             v = tags[k]
             base += f"_{k}{v:g}" if isinstance(v, float) else f"_{k}{v}"
-        return base.replace("/", "-")
+        return base.replace("/", "-").replace(" ", ",")
+
+    def _population_charged(self) -> bool:
+        from . import population
+        v = self.deck_vars()
+        return population.is_population(v) and population.is_charged(v)
 
     # derived -------------------------------------------------------------------------------
     @property
