@@ -139,6 +139,9 @@ def species_vars(s: int, size: dict, charge: dict | None, material: dict | None 
         if size.get("fractions"):
             v["rfrac" + suf] = " ".join(_num(f) for f in size["fractions"])
     if charge is not None:
+        if s > 1:
+            # a species' charge rule is its own: none of species 1's charge values carries over
+            charge = {"q": 0.0, "sigma": 0.0, "sd": 0.0, "pos": 0.5, **charge}
         if charge["dist"] != "fixed":
             v["q_dist" + suf] = charge["dist"]
         for key, var in (("q", "q"), ("sigma", "q_sigma"), ("sd", "q_sd"), ("pos", "q_pos")):

@@ -52,7 +52,8 @@ def load(path) -> dict:
 
 def params(d: dict) -> list[DepositionParams]:
     """Every run of the study (grid x seeds)."""
-    from .cli import _refused, deck_params
+    from .axes import deck_params
+    from .runner import RESERVED
     species = d.get("species")
     if species is None:
         pop = dict(d.get("population", {}))
@@ -73,8 +74,7 @@ def params(d: dict) -> list[DepositionParams]:
         if k in fixed:
             base[k] = float(fixed.pop(k))
     N = int(fixed.pop("N", d.get("N", 500)))
-    refused = _refused("study")
-    refused.pop("rp", None)
+    refused = dict(RESERVED, seed="seeds = [...] of the study file")
     grid = d.get("grid", {})
     names = list(grid)
     out = []
@@ -191,7 +191,7 @@ def figures(d: dict, results: list[dict], out: Path) -> list[Path]:
 
 def run(path, runner, jobs: int = 1, progress: bool = True) -> dict:
     """Run a study file: the runs (resumable), then tables and figures under its out folder."""
-    from .cli import announce
+    from .axes import announce
     from .sweep import Sweep
     d = load(path)
     ps = params(d)
