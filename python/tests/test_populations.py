@@ -122,12 +122,12 @@ def test_rdf_contact_is_rdf_slab_for_one_size():
 
 @pytest.fixture(scope="module")
 def lognormal_gauss_run(build_dir, tmp_path_factory):
-    """120 particles, lognormal radii (median 2 um, gsd 1.25, clipped to 1.3-3.2 um), Gaussian
+    """120 particles, lognormal radii (median 2 um, gsd 1.25, clipped to 1-4 um), Gaussian
     charges (mean 100, sd 30 e_0), plane rain."""
     d = tmp_path_factory.mktemp("lognormal")
     text = lmp_run(build_dir, DECK, d, {
-        "N": 120, "L_rp": 10, "r_dist": "lognormal", "rp_gsd": 1.25, "rp_lo": 1.3e-6,
-        "rp_hi": 3.2e-6, "q_dist": "gauss", "q": 100, "q_sd": 30, "inject": "plane",
+        "N": 120, "L_rp": 10, "r_dist": "lognormal", "rp_gsd": 1.25, "rp_lo": 1.0e-6,
+        "rp_hi": 4.0e-6, "q_dist": "gauss", "q": 100, "q_sd": 30, "inject": "plane",
         "settle_max": 100, "zlo_rp": 2, "top_rp": 3})
     return d, text
 
@@ -137,13 +137,24 @@ def test_deck_draws_follow_the_requested_distributions(lognormal_gauss_run):
     snap = packing.read_dump(d / "final.dump", last_only=True)
     r, q = snap["radius"], snap["q"] / E0
     assert len(r) == 120
-    size = {"dist": "lognormal", "median": 2e-6, "gsd": 1.25, "lo": 1.3e-6, "hi": 3.2e-6}
+    size = {"dist": "lognormal", "median": 2e-6, "gsd": 1.25, "lo": 1.0e-6, "hi": 4.0e-6}
     # KS tests at the 1 % level: a correct deck fails one of them 2 % of the time at most, but
     # the draws are fixed by the seed, so the test is deterministic; a wrong law (gsd or median
     # off by 10 %, the clip missing) gives p < 1e-3 at n = 120
     assert stats.kstest(r, population.radius_cdf(size)).pvalue > 0.01
-    assert r.min() >= 1.3e-6 and r.max() <= 3.2e-6
+    assert r.min() >= 1.0e-6 and r.max() <= 4.0e-6
     assert stats.kstest(q, stats.norm(100, 30).cdf).pvalue > 0.01
+    # the KS test has little power against a wrong width at n = 120; the moments of ln r (the
+    # truncated normal of the clipped lognormal) and of q within 4 standard errors (SE of a
+    # mean sd/sqrt(n), of an sd sd/sqrt(2 n)) catch a width off by 20 % (> 5 SE)
+    s = math.log(1.25)
+    tn = stats.truncnorm(math.log(1.0e-6 / 2e-6) / s, math.log(4.0e-6 / 2e-6) / s,
+                         loc=math.log(2e-6), scale=s)
+    n = len(r)
+    assert abs(np.log(r).mean() - tn.mean()) < 4 * tn.std() / math.sqrt(n)
+    assert abs(np.log(r).std(ddof=1) - tn.std()) < 4 * tn.std() / math.sqrt(2 * n)
+    assert abs(q.mean() - 100) < 4 * 30 / math.sqrt(n)
+    assert abs(q.std(ddof=1) - 30) < 4 * 30 / math.sqrt(2 * n)
     # the run says and records its protocol, keeps log.lammps small and reports progress
     assert "GC PROTOCOL inject plane" in text
     assert text.count("Loop time") <= 4, "log.lammps holds the one-by-one loop's runs"
