@@ -223,3 +223,45 @@ def test_powder_example_short_version(build_dir, tmp_path):
     assert snap.n == 60 and 3e-6 <= snap["radius"].min() and snap["radius"].max() <= 7e-6
     np.testing.assert_allclose(snap["q"], 5e-7 * 4 * np.pi * snap["radius"] ** 2, rtol=1e-5)
     assert float(m.group(3)) == pytest.approx(snap["q"].sum(), rel=1e-5)
+
+
+def _figure_texts(monkeypatch, fn, results, out):
+    """Every text (titles, labels, legend entries) of the figures fn draws from results."""
+    from granular_charged import figures
+    texts = []
+
+    def capture(fig, path, data=None, tight=True):
+        for t in fig.findobj(lambda a: hasattr(a, "get_text")):
+            texts.append(t.get_text())
+        import matplotlib.pyplot as plt
+        plt.close(fig)
+        return path
+
+    monkeypatch.setattr(figures, "save", capture)
+    fn(results, out)
+    return " ".join(texts)
+
+
+def test_figures_carry_the_users_material_not_the_paper(monkeypatch, tmp_path):
+    """The paper's annotations only on the paper's material; a user's runs are labelled with
+    theirs (all_figures decides; rdf and fZ are drawn here from two kept paper-size runs)."""
+    import copy
+    from granular_charged import figures
+    from granular_charged.runner import load_result_files
+    kept = SRC / "doc" / "data" / "paper-size" / "runs"
+    res = load_result_files([kept / "rp2um_U1_g10mJ_q0_N2000_s1" / "result.json",
+                             kept / "rp2um_U1_g10mJ_q400_N2000_s1_exact" / "result.json"])
+    assert len(res) == 2
+    figures.PAPER.update(on=not figures.material_label(res), material=figures.material_label(res))
+    assert "paper" in _figure_texts(monkeypatch, figures.rdf, res, tmp_path)
+    mine = copy.deepcopy(res)
+    for r in mine:
+        r["params"]["rho"] = 3000.0
+        r["params"]["extra"] = dict(r["params"].get("extra") or {}, r_dist="uniform")
+    lab = figures.material_label(mine)
+    assert lab == "rho 3000, uniform radii"
+    figures.PAPER.update(on=False, material=lab)
+    for fn in (figures.rdf, figures.fZ, figures.phi_vs_q):
+        t = _figure_texts(monkeypatch, fn, mine, tmp_path)
+        assert "paper" not in t.lower() and "rho 3000" in t, fn.__name__
+    figures.PAPER.update(on=True, material="")
