@@ -303,11 +303,13 @@ def _population_vars(a) -> dict:
     from .population import CHARGE_KEYS, SIZE_KEYS, parse_spec, species_vars
     v = {}
     if getattr(a, "size", None) or getattr(a, "charge", None):
-        size = parse_spec(a.size, SIZE_KEYS, "--size") if a.size else {"dist": "one", "r": a.rp}
-        if size["dist"] == "one":
-            size.setdefault("r", a.rp if not isinstance(a.rp, list) else a.rp[0])
+        rp = a.rp[0] if isinstance(a.rp, list) else a.rp
+        size = parse_spec(a.size, SIZE_KEYS, "--size") if a.size else {"dist": "one", "r": rp}
+        size.setdefault("r", rp) if size["dist"] == "one" else None
         charge = parse_spec(a.charge, CHARGE_KEYS, "--charge") if a.charge else None
         v = species_vars(1, size, charge)
+        if size["dist"] == "one":
+            v.pop("rp", None)          # one radius: --rp (a sweep's axis) stays
     if getattr(a, "inject", "auto") != "auto":
         v["inject"] = a.inject
     return v

@@ -3,7 +3,6 @@ progress lines, --var axes, study files, the polydisperse analysis and the powde
 
 The LAMMPS runs are small (N <= 120 in L = 9-10 r_p) and short (settle_max 100): they test the
 draws and the bookkeeping, not the packing's statistics."""
-import math
 import os
 import re
 import subprocess
@@ -11,10 +10,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy import stats
 
 from granular_charged import packing, population
-from granular_charged.params import E0, DepositionParams, ParamError
+from granular_charged.params import DepositionParams, ParamError
 
 SRC = Path(__file__).resolve().parents[2]
 DECK = SRC / "python" / "granular_charged" / "decks" / "in.deposition"
@@ -118,99 +116,7 @@ def test_rdf_contact_is_rdf_slab_for_one_size():
     assert np.allclose(xc, rc) and np.allclose(g, gx, rtol=1e-9, atol=1e-12)
 
 
-# ---- the deck ---------------------------------------------------------------------------------
-
-@pytest.fixture(scope="module")
-def lognormal_gauss_run(build_dir, tmp_path_factory):
-    """120 particles, lognormal radii (median 2 um, gsd 1.25, clipped to 1-4 um), Gaussian
-    charges (mean 100, sd 30 e_0), plane rain."""
-    d = tmp_path_factory.mktemp("lognormal")
-    text = lmp_run(build_dir, DECK, d, {
-        "N": 120, "L_rp": 10, "r_dist": "lognormal", "rp_gsd": 1.25, "rp_lo": 1.0e-6,
-        "rp_hi": 4.0e-6, "q_dist": "gauss", "q": 100, "q_sd": 30, "inject": "plane",
-        "settle_max": 100, "zlo_rp": 2, "top_rp": 3})
-    return d, text
-
-
-def test_deck_draws_follow_the_requested_distributions(lognormal_gauss_run):
-    d, text = lognormal_gauss_run
-    snap = packing.read_dump(d / "final.dump", last_only=True)
-    r, q = snap["radius"], snap["q"] / E0
-    assert len(r) == 120
-    size = {"dist": "lognormal", "median": 2e-6, "gsd": 1.25, "lo": 1.0e-6, "hi": 4.0e-6}
-    # KS tests at the 1 % level: a correct deck fails one of them 2 % of the time at most, but
-    # the draws are fixed by the seed, so the test is deterministic; a wrong law (gsd or median
-    # off by 10 %, the clip missing) gives p < 1e-3 at n = 120
-    assert stats.kstest(r, population.radius_cdf(size)).pvalue > 0.01
-    assert r.min() >= 1.0e-6 and r.max() <= 4.0e-6
-    assert stats.kstest(q, stats.norm(100, 30).cdf).pvalue > 0.01
-    # the KS test has little power against a wrong width at n = 120; the moments of ln r (the
-    # truncated normal of the clipped lognormal) and of q within 4 standard errors (SE of a
-    # mean sd/sqrt(n), of an sd sd/sqrt(2 n)) catch a width off by 20 % (> 5 SE)
-    s = math.log(1.25)
-    tn = stats.truncnorm(math.log(1.0e-6 / 2e-6) / s, math.log(4.0e-6 / 2e-6) / s,
-                         loc=math.log(2e-6), scale=s)
-    n = len(r)
-    assert abs(np.log(r).mean() - tn.mean()) < 4 * tn.std() / math.sqrt(n)
-    assert abs(np.log(r).std(ddof=1) - tn.std()) < 4 * tn.std() / math.sqrt(2 * n)
-    assert abs(q.mean() - 100) < 4 * 30 / math.sqrt(n)
-    assert abs(q.std(ddof=1) - 30) < 4 * 30 / math.sqrt(2 * n)
-    # the run says and records its protocol, keeps log.lammps small and reports progress
-    assert "GC PROTOCOL inject plane" in text
-    assert text.count("Loop time") <= 4, "log.lammps holds the one-by-one loop's runs"
-    prog = [ln for ln in text.splitlines() if ln.startswith("GC PROGRESS")]
-    assert len(prog) >= 10 and prog[-1].startswith("GC PROGRESS 120 / 120")
-    from granular_charged.runner import parse_progress
-    assert parse_progress(prog[-1])["k"] == 120
-
-
-def test_computes_and_python_agree_on_a_polydisperse_packing(lognormal_gauss_run):
-    d, text = lognormal_gauss_run
-    res = result_line(text)
-    snap = packing.read_dump(d / "final.dump", last_only=True)
-    zlo, zhi = float(res["zlo"]), float(res["zhi"])
-    assert zhi > zlo
-    # the same definitions (exact sphere-slab volumes with each particle's radius; contact
-    # r_ij <= r_i + r_j): equal to the dump's 12 digits
-    assert float(res["phi"]) == pytest.approx(packing.phi_slab(snap, zlo, zhi), rel=1e-8)
-    assert float(res["Z"]) == pytest.approx(
-        packing.coordination_stats(snap, zlo, zhi)["Z"], rel=1e-8)
-    cls = packing.by_class(snap, None, zlo, zhi)
-    n_all = sum(c["n"] for c in cls["classes"] if c["class"] == "all")
-    n_cls = sum(c["n"] for c in cls["classes"] if c["class"] != "all")
-    assert n_all == n_cls > 0
-
-
-def test_mixture_area_and_bipolar_charges_and_species(build_dir, tmp_path):
-    """Two species by number 1 : 3, species 1 uniform 1.5-2.5 um charged by area, species 2 a
-    discrete 1.5 / 3 um (1 : 3) bipolar +-300 e_0 with 30 % positive, its own material; rain
-    (one by one)."""
-    sigma = 2e-6
-    text = lmp_run(build_dir, DECK, tmp_path, {
-        "N": 120, "L_rp": 10, "species": 2, "frac": 1, "frac_2": 3,
-        "r_dist": "uniform", "rp_lo": 1.5e-6, "rp_hi": 2.5e-6, "q_dist": "area",
-        "q_sigma": sigma, "r_dist_2": "discrete", "radii_2": "1.5e-6 3e-6", "rfrac_2": "1 3",
-        "q_dist_2": "bipolar", "q_2": 300, "q_pos_2": 0.3, "q_sigma_2": 0, "rho_2": 4000, "E_2": 1e9,
-        "gamma_2": 0.02, "inject": "rain", "settle_max": 100, "zlo_rp": 2, "top_rp": 3})
-    assert "GC PROTOCOL inject rain" in text
-    snap = packing.read_dump(tmp_path / "final.dump", last_only=True)
-    t, r, q = snap["type"].astype(int), snap["radius"], snap["q"] / E0
-    n2 = int((t == 2).sum())
-    # binomial(120, 3/4): sd 4.7; 4 sd either way
-    assert abs(n2 - 90) < 4 * math.sqrt(120 * 0.75 * 0.25)
-    # charge proportional to the area, particle by particle (the dump's 12 digits... %g: 6)
-    np.testing.assert_allclose(q[t == 1], population.area_charge(r[t == 1], sigma), rtol=1e-5)
-    assert stats.kstest(r[t == 1], stats.uniform(1.5e-6, 1e-6).cdf).pvalue > 0.01
-    assert set(np.round(r[t == 2] * 1e7).astype(int)) <= {15, 30}
-    big = int((np.abs(r[t == 2] - 3e-6) < 1e-9).sum())
-    assert abs(big - 0.75 * n2) < 4 * math.sqrt(n2 * 0.75 * 0.25)
-    pos = int((q[t == 2] > 0).sum())
-    np.testing.assert_allclose(np.abs(q[t == 2]), 300.0, rtol=1e-5)
-    assert abs(pos - 0.3 * n2) < 4 * math.sqrt(n2 * 0.3 * 0.7)
-    # each species' mass from its own density
-    mass_ratio = None  # masses are not in the dump; the density is checked through the restart
-    del mass_ratio
-
+# ---- the example (the deck's population runs: python/tests_powder) ------------------------------
 
 def test_powder_example_short_version(build_dir, tmp_path):
     """examples/powder/in.powder, short: it runs, and every particle's charge is sigma 4 pi r^2
