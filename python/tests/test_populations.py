@@ -171,3 +171,30 @@ def test_figures_carry_the_users_material_not_the_paper(monkeypatch, tmp_path):
         t = _figure_texts(monkeypatch, fn, mine, tmp_path)
         assert "paper" not in t.lower() and "rho 3000" in t, fn.__name__
     figures.PAPER.update(on=True, material="")
+
+
+def test_progress_bar_follows_the_log(tmp_path):
+    """The run's bar reads the deck's GC PROGRESS lines as log.lammps grows (a partial last line
+    is left for the next read)."""
+    from granular_charged.runner import Runner
+
+    class Bar:
+        total = n = None
+        post = {}
+
+        def set_postfix(self, refresh=False, **kw):
+            self.post = kw
+
+        def refresh(self):
+            pass
+
+    log = tmp_path / "log.lammps"
+    log.write_text("units si\nGC PROGRESS 40 / 300 particles, step 1234, elapsed 3 s, eta 20 s\n"
+                   "GC PROGRESS 80 / 300 particles, step 2468, elapsed 6 s, eta 17 s\nGC PRO")
+    bar = Bar()
+    pos = Runner._progress(log, 0, bar)
+    assert (bar.n, bar.total, bar.post["step"]) == (80, 300, 2468)
+    with open(log, "a") as fh:
+        fh.write("GRESS 120 / 300 particles, step 3702, elapsed 9 s, eta 14 s\n")
+    Runner._progress(log, pos, bar)
+    assert bar.n == 120
