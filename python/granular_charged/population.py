@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 
-from .params import E0, ParamError
+from .params import E0, ParamError, population_charged
 
 SIZE_KEYS = {"one": ("r",), "uniform": ("lo", "hi"), "lognormal": ("median", "gsd", "lo", "hi"),
              "discrete": ("radii", "fractions")}
@@ -226,17 +226,10 @@ def is_population(vars_: dict) -> bool:
             or vars_.get("q_dist", "fixed") != "fixed")
 
 
-def species_charged(sp: dict) -> bool:
-    """Whether a species' rule gives charge (the deck's chg<s>)."""
-    c = sp["charge"]
-    return ((c["dist"] != "area" and c["q"] != 0) or (c["dist"] != "fixed" and c["sigma"] != 0)
-            or (c["dist"] == "gauss" and c["sd"] != 0))
-
-
 def is_charged(vars_: dict) -> bool:
     if not is_population(vars_):
         return float(vars_.get("q", 0)) != 0
-    return any(species_charged(sp) for sp in describe(vars_)["species"])
+    return population_charged(vars_)
 
 
 def protocol(vars_: dict) -> str:

@@ -253,7 +253,11 @@ class Runner:
                     raise RunError(f"{workdir}: not started (the study was stopped)")
                 t0 = time.monotonic()
                 ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-                r = self._watch(cmd, env, workdir, kind)
+                if self.show_progress and kind == "deposition":
+                    r = self._watch(cmd, env, workdir, kind)
+                else:
+                    r = subprocess.run(cmd, env=env, capture_output=True, text=True,
+                                       timeout=self.timeout)
                 wall = time.monotonic() - t0
                 ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         res_file = workdir / "lammps.json"
