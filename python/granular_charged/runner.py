@@ -184,10 +184,13 @@ def parse_progress(line: str) -> dict | None:
     'GC PROGRESS k / N particles, step S, elapsed T s, eta T s'."""
     w = line.replace(",", " ").split()
     try:
-        return {"k": int(float(w[2])), "N": int(w[4]), "step": int(w[7]),
-                "elapsed": float(w[9]), "eta": float(w[12])}
+        out = {"k": int(float(w[2])), "N": int(w[4]), "step": int(w[7]),
+               "elapsed": float(w[9]), "eta": float(w[12])}
     except (IndexError, ValueError):
         return None
+    # the rain's line goes on during the settling with the stop rule's kinetic energy
+    out["kerel"] = float(w[15]) if len(w) > 15 and w[14] == "kerel" else None
+    return out
 
 
 class Runner:
@@ -326,14 +329,24 @@ class Runner:
         except OSError:
             return pos
         end = chunk.rfind(b"\n") + 1
-        last = None
+        last = settle = None
         for line in chunk[:end].decode(errors="replace").splitlines():
             if line.startswith("GC PROGRESS "):
                 last = parse_progress(line)
+            elif line.startswith("GC SETTLE "):
+                settle = line.replace(",", " ").split()
         if last is not None:
             bar.total = last["N"]
             bar.n = last["k"]
-            bar.set_postfix(step=last["step"], refresh=False)
+            post = {"step": last["step"]}
+            if last.get("kerel") is not None and last["k"] >= last["N"]:
+                post["settling: kerel"] = f"{last['kerel']:.2g}"
+            bar.set_postfix(post, refresh=False)
+        if settle is not None:
+            # the last settling: the stop rule's kinetic energy against its threshold
+            bar.set_postfix({"step": settle[3], "settling: kerel": f"{settle[5]} -> {settle[8].rstrip(')')}",
+                             "moving": settle[-1]}, refresh=False)
+        if last is not None or settle is not None:
             bar.refresh()
         return pos + end
 

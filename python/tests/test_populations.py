@@ -182,8 +182,8 @@ def test_progress_bar_follows_the_log(tmp_path):
         total = n = None
         post = {}
 
-        def set_postfix(self, refresh=False, **kw):
-            self.post = kw
+        def set_postfix(self, ordered_dict=None, refresh=True, **kw):   # tqdm's signature
+            self.post = dict(ordered_dict or {}, **kw)
 
         def refresh(self):
             pass
@@ -196,5 +196,10 @@ def test_progress_bar_follows_the_log(tmp_path):
     assert (bar.n, bar.total, bar.post["step"]) == (80, 300, 2468)
     with open(log, "a") as fh:
         fh.write("GRESS 120 / 300 particles, step 3702, elapsed 9 s, eta 14 s\n")
-    Runner._progress(log, pos, bar)
+    pos = Runner._progress(log, pos, bar)
     assert bar.n == 120
+    # the last settling: the stop rule's kinetic energy and the particles still moving
+    with open(log, "a") as fh:
+        fh.write("GC SETTLE step 9000, kerel 0.0031 (stop below 1e-4), moving 2\n")
+    Runner._progress(log, pos, bar)
+    assert bar.post["settling: kerel"] == "0.0031 -> 1e-4" and bar.post["moving"] == "2"
