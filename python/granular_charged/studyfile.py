@@ -131,15 +131,27 @@ def tables(d: dict, results: list[dict], out: Path):
     return runs, summ
 
 
+def study_label(d: dict, results: list[dict]) -> str:
+    """The figures' title: the study's name, its material (what differs from the paper's, the
+    population's rules, gamma, U0), the protocols and N."""
+    if not results:
+        return d["name"]
+    from .figures import material_label
+    p0 = results[0]["params"]
+    protos = sorted({str(r.get("protocol")) for r in results})
+    mat = ", ".join(x for x in (material_label(results), f"gamma {p0['gamma']:g}",
+                                f"U0 {p0['U0']:g}") if x)
+    return f"{d['name']} ({mat}; {', '.join(protos)}; N = {p0['N']})"
+
+
 def figures(d: dict, results: list[dict], out: Path) -> list[Path]:
     """The study's figures, each titled with its name and protocol (no paper annotation)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     out.mkdir(parents=True, exist_ok=True)
+    label = study_label(d, results)
     name = d["name"]
-    protos = sorted({str(r.get("protocol")) for r in results})
-    label = f"{name} ({', '.join(protos)}; N = {results[0]['params']['N']})" if results else name
     paths = []
     for axis in d.get("grid", {}):
         xs = sorted({grid_value(r, axis) for r in results}, key=lambda v: float(v))
@@ -151,7 +163,7 @@ def figures(d: dict, results: list[dict], out: Path) -> list[Path]:
             ax.errorbar([float(x) for x in xs], m, yerr=s, marker="o", capsize=3)
             ax.set_xlabel(axis)
             ax.set_ylabel("phi" if k == "phi" else "<Z>")
-        fig.suptitle(f"{label}: mean +- sd over the seeds", fontsize=9)
+        fig.suptitle(f"{label}\nmean +- sd over the seeds", fontsize=8)
         fig.tight_layout()
         paths.append(out / f"phi_Z_vs_{axis}.png")
         fig.savefig(paths[-1], dpi=120)
@@ -176,12 +188,13 @@ def figures(d: dict, results: list[dict], out: Path) -> list[Path]:
         a3.plot(xc, gx, lw=0.8, label=lab)
     a1.set_xlabel("Z")
     a1.set_ylabel("f(Z)")
+    a1.set_xlim(-0.5, 10.5)
     a2.set_xlabel("r / <d>")
     a2.set_ylabel("g(r)")
     a3.set_xlabel("r / (r_i + r_j)")
     a3.set_ylabel("g")
     a1.legend(fontsize=6)
-    fig.suptitle(f"{label}: f(Z) and g(r) of the analysis slab (first seed)", fontsize=9)
+    fig.suptitle(f"{label}\nf(Z) and g(r) of the analysis slab (first seed)", fontsize=8)
     fig.tight_layout()
     paths.append(out / "fZ_gr.png")
     fig.savefig(paths[-1], dpi=120)

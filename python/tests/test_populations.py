@@ -101,6 +101,11 @@ def test_study_file_grid_seeds_and_protocol_warning(tmp_path, caplog):
         announce(studyfile.params(studyfile.load(f)), tmp_path)
     assert "DIFFERENT" not in caplog.text and "every run: plane" in caplog.text
     assert "estimated cost" in caplog.text
+    # the figures' title names the study and its material
+    fake = [{"params": dict(vars(p), extra=dict(p.extra)), "protocol": "plane"} for p in ps]
+    label = studyfile.study_label(d, fake)
+    assert label.startswith("my dust (rho 3000, E 1e+08, uniform radii, area charges, gamma 0.02")
+    assert "paper" not in label
 
 
 def test_rdf_contact_is_rdf_slab_for_one_size():
