@@ -116,6 +116,13 @@ def tables(d: dict, results: list[dict], out: Path):
             cls.append({**{k: grid_value(r, k) for k in names}, "seed": r["params"]["seed"],
                         **{k: c[k] for k in ("species", "class", "r_lo", "r_hi", "n", "Z")}})
     runs = pd.DataFrame(rows)
+    for k in names:                  # numbers as numbers (sorted by value, not as text)
+        try:
+            runs[k] = runs[k].astype(float)
+        except (ValueError, TypeError):
+            pass
+    if names and len(runs):
+        runs = runs.sort_values(names + ["seed"], kind="stable")
     runs.to_csv(out / "runs.csv", index=False)
     if names and len(runs):
         g = runs.groupby(names, dropna=False)
