@@ -1,6 +1,7 @@
 """``granular-charged``: the command line of the package (also ``python3 -m granular_charged``).
 
-Subcommands: run (one deposition), sweep (many, resumable), figures (from finished runs),
+Subcommands: run (one deposition), sweep (many, resumable), study (a TOML study file of one's
+own powder: doc/populations.md), figures (from finished runs),
 demo (the reduced Fig. 2 study), reproduce (the paper's checks this package has, and the list of
 its claims not yet covered). ``-v``/``-q`` set the log level; ``--build-dir`` the LAMMPS build.
 """
