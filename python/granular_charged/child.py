@@ -48,6 +48,7 @@ def extract_deposition(lmp) -> dict:
     out = {k: _equal(lmp, v) for k, v in names.items()}
     for k in ("steps", "inserted", "atoms", "lost", "flying"):
         out[k] = int(round(out[k]))
+    out["inject"] = str(lmp.extract_variable("inject"))     # the protocol the run used
     out["slab"] = bool(_equal(lmp, "slab_ok"))
     out["phi"] = out["Z"] = None
     out["fZ"] = out["fZ_count"] = []

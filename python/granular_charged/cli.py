@@ -1,6 +1,7 @@
 """``granular-charged``: the command line of the package (also ``python3 -m granular_charged``).
 
-Subcommands: run (one deposition), sweep (many, resumable), figures (from finished runs),
+Subcommands: run (one deposition), sweep (many, resumable), study (a TOML study file of one's
+own powder: doc/populations.md), figures (from finished runs),
 demo (the reduced Fig. 2 study), reproduce (the paper's checks this package has, and the list of
 its claims not yet covered). ``-v``/``-q`` set the log level; ``--build-dir`` the LAMMPS build.
 """
@@ -71,10 +72,23 @@ def _deck_options(p: argparse.ArgumentParser, many: bool):
                    help="charge per particle [e0]")
     p.add_argument("--N", type=_count, default=2000, help="particles to inject")
     p.add_argument("--np", type=_count, default=1, help="MPI ranks per run (mpirun)")
-    p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
+    p.add_argument("--var", nargs="+", action="append", default=[], metavar="NAME VALUE",
                    help="any other variable of the deck (its 'variable NAME index' lines), e.g. "
                         "--var L_rp 14 --var farfield average; not those with an option of "
-                        "their own (--rp --U0 --gamma --q --N --seed --tracer)")
+                        "their own (--rp --U0 --gamma --q --N --seed --tracer)"
+                        + ("; several values (--var E 1e8 2e8) are an axis of the sweep" if many
+                           else ""))
+    p.add_argument("--size", default=None, metavar="SPEC",
+                   help="size population (doc/populations.md): 'uniform lo=3e-6 hi=7e-6', "
+                        "'lognormal median=5e-6 gsd=1.2 [lo= hi=]', 'discrete radii=2e-6,4e-6 "
+                        "[fractions=0.7,0.3]' (sets rp to its mean or median)")
+    p.add_argument("--charge", default=None, metavar="SPEC",
+                   help="charge rule: 'fixed q=400', 'area sigma=1e-5' [C/m^2], 'gauss q=400 "
+                        "sd=50', 'bipolar q=400 pos=0.5' (gauss, bipolar: sigma= instead of q= "
+                        "for a magnitude proportional to the area)")
+    p.add_argument("--inject", choices=["auto", "rain", "plane", "sequential"], default="auto",
+                   help="injection protocol (auto: rain when no particle is charged, plane when "
+                        "any is; doc/deposition.md)")
     p.add_argument("--tracer", type=int, default=0, help="follow this particle id (Fig. 8)")
     p.add_argument("--checkpoint", type=int, default=0, metavar="K",
                    help="plane and sequential injection: a restart point every K particles; an "
@@ -114,6 +128,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--jobs", type=_count, default=1, help="runs at a time")
     p.add_argument("--figures", default=None, metavar="DIR", help="then draw the figures here")
     _deck_options(p, many=True)
+
+    p = sub.add_parser("study", parents=[common], help="a study of your own powder from a TOML file",
+                       description="Run the study a TOML file describes (material(s), population, "
+                                   "protocol, grid, seeds; doc/populations.md), resumably, then its "
+                                   "tables and figures (labelled with its name) in its out folder.")
+    p.add_argument("file", help="the study file (TOML)")
+    p.add_argument("--jobs", type=_count, default=1, help="runs at a time")
+    p.add_argument("--np", type=_count, default=1, help="MPI ranks per run")
+    p.add_argument("--no-render", action="store_true", help="no rendered packing images")
+    p.add_argument("--estimate-only", action="store_true",
+                   help="print the runs' protocols and estimated cost, run nothing")
 
     p = sub.add_parser("figures", parents=[common], help="figures and tables of finished runs",
                        description="The paper's figures (PNG + CSV) and the summary table of "
@@ -274,6 +299,30 @@ def _refused(command: str) -> dict:
     return dict(RESERVED, **own)
 
 
+def _population_vars(a) -> dict:
+    """Deck variables of --size, --charge, --inject (none when not given)."""
+    from .population import CHARGE_KEYS, SIZE_KEYS, parse_spec, species_vars
+    v = {}
+    if getattr(a, "size", None) or getattr(a, "charge", None):
+        rp = a.rp[0] if isinstance(a.rp, list) else a.rp
+        size = parse_spec(a.size, SIZE_KEYS, "--size") if a.size else {"dist": "one", "r": rp}
+        size.setdefault("r", rp) if size["dist"] == "one" else None
+        charge = parse_spec(a.charge, CHARGE_KEYS, "--charge") if a.charge else None
+        v = species_vars(1, size, charge)
+        if size["dist"] == "one":
+            v.pop("rp", None)          # one radius: --rp (a sweep's axis) stays
+    if getattr(a, "inject", "auto") != "auto":
+        v["inject"] = a.inject
+    return v
+
+
+
+
+
+
+from .axes import announce, deck_params, sweep_params, var_axes  # noqa: E402
+
+
 def _vars(a, command: str) -> tuple[dict, dict]:
     """--var pairs checked against the deck that will run: (DepositionParams fields, extra)."""
     from .deckfile import deck_variables
@@ -302,15 +351,21 @@ def _runner(a, render=True):
 
 
 def cmd_run(a) -> int:
-    from .params import DepositionParams
     from .runner import RunError, Runner
     from .sweep import fmt
-    fields, extra = _vars(a, "run")
-    p = DepositionParams(rp=a.rp, U0=a.U0, gamma=a.gamma, q=a.q, N=a.N, seed=a.seed,
-                         extra=extra, **fields)
+    from . import estimate
+    single, _ = var_axes(a.var, "run")
+    p = deck_params(single, dict(rp=a.rp, U0=a.U0, gamma=a.gamma, q=a.q), _population_vars(a),
+                    _refused("run"), a.N, a.seed)
     Runner.check(p, a.tracer)
+    from .population import protocol
+    log.info("injection protocol: %s%s", protocol(p.deck_vars()),
+             " (auto: rain when no particle is charged, plane when any is)"
+             if a.inject == "auto" else "")
+    log.info("%s", estimate.describe(estimate.estimate([p], [a.out])))
     out = _out_dir(a.out)
     runner = _runner(a, not a.no_render)
+    runner.show_progress = a.progress
     log.info("run %s in %s (LAMMPS build %s)", p.key(), out.resolve(), runner.build.path)
     try:
         r = runner.deposition(p, out, force=a.force, tracer=a.tracer)
@@ -326,26 +381,34 @@ def cmd_run(a) -> int:
 
 def cmd_sweep(a) -> int:
     from .runner import Runner
-    from .sweep import PAPER_SETS, Sweep, expand, load_results
-    fields, extra = _vars(a, "sweep")
+    from .sweep import PAPER_SETS, Sweep, load_results
+    single, axes = var_axes(a.var, "sweep")
     sets = PAPER_SETS if a.preset == "paper" else [dict(rp=a.rp, U0=a.U0, gamma=a.gamma, q=a.q)]
-    params = expand(sets, a.N, a.seeds, extra, fields)
+    popvars = _population_vars(a)
+    params = sweep_params(sets, single, axes, popvars, _refused("sweep"), a.N, a.seeds)
     for p in params:
         Runner.check(p, a.tracer)
+    announce(params, a.out, a.inject)
     out = _out_dir(a.out)
     figs = _out_dir(a.figures, "--figures") if a.figures else None
     runner = _runner(a, not a.no_render)
     if not runner.build.capabilities["coul/fmm"]:
-        skip = [p for p in params if p.q]
+        from .population import is_charged
+        skip = [p for p in params if is_charged(p.deck_vars())]
         if skip:
             log.warning("%d charged runs NOT run: fix coul/fmm is absent from %s", len(skip),
                         runner.build.path)
-        params = [p for p in params if not p.q]
+        params = [p for p in params if not is_charged(p.deck_vars())]
+    runner.show_progress = a.progress and a.jobs == 1
     res = Sweep(runner, out, jobs=a.jobs, progress=a.progress).run(params, a.tracer)
     if figs is not None and params:
         from .tables import variant
         _figures(load_results(out), figs, None, variant(vars(params[0])))
     return 0 if len(res) == len(params) else 1
+
+
+
+
 
 
 def _figures(results, out: Path, t2dir: Path | None, variant: str | None = None):
@@ -362,6 +425,19 @@ def _figures(results, out: Path, t2dir: Path | None, variant: str | None = None)
     paths = figures.all_figures(results, out, rows)
     log.info("%d figures in %s", len(paths), out.resolve())
     return paths
+
+
+def cmd_study(a) -> int:
+    from . import studyfile
+    if a.estimate_only:
+        d = studyfile.load(a.file)
+        announce(studyfile.params(d), Path(d["out"]) / "runs", d["protocol"])
+        return 0
+    res = studyfile.run(a.file, _runner(a, not a.no_render), jobs=a.jobs, progress=a.progress)
+    print(res["summary"].to_string(index=False))
+    for f in res["figures"]:
+        print(f)
+    return 0 if res["complete"] else 1
 
 
 def cmd_figures(a) -> int:
@@ -506,7 +582,7 @@ def cmd_one_at_a_time(a) -> int:
                          study.format_differences(d))
 
 
-COMMANDS = {"run": cmd_run, "sweep": cmd_sweep, "figures": cmd_figures, "table2": cmd_table2,
+COMMANDS = {"run": cmd_run, "sweep": cmd_sweep, "study": cmd_study, "figures": cmd_figures, "table2": cmd_table2,
             "reproduce": cmd_reproduce, "demo": cmd_demo, "epd": cmd_epd,
             "conventions": cmd_conventions, "one-at-a-time": cmd_one_at_a_time}
 

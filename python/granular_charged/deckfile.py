@@ -25,8 +25,9 @@ def deck_path(name: str):
 
 
 def parse_index_variables(text: str) -> dict[str, str]:
-    """{name: default} of the ``variable NAME index DEFAULT`` lines of a deck's text."""
-    return {m.group(1): m.group(2) for m in _INDEX.finditer(text)}
+    """{name: default} of the ``variable NAME index DEFAULT`` lines of a deck's text (names
+    starting with _ are the deck's own, not inputs)."""
+    return {m.group(1): m.group(2) for m in _INDEX.finditer(text) if not m.group(1).startswith("_")}
 
 
 @lru_cache(maxsize=None)

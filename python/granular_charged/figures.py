@@ -69,9 +69,39 @@ def z_colorbar(fig, ax):
     return cb
 
 
+# the paper's values and annotations: only for runs of the paper's material and one kind of
+# particle (set by all_figures); material: the user's material, prefixed to the series labels
+PAPER = {"on": True, "material": ""}
+
+
+def _paper() -> bool:
+    return PAPER["on"]
+
+
+def material_label(results) -> str:
+    """The material of the runs as a label ('' for the paper's): the values that differ from
+    the paper's Table 1 and the population (its rules), e.g. 'rho 3000, E 1e+08, uniform radii'."""
+    from .params import DepositionParams as D
+    parts = {}
+    for r in results:
+        p = r["params"]
+        for k in ("rho", "E", "nu", "e", "mu"):
+            if p.get(k, getattr(D, k)) != getattr(D, k):
+                parts[k] = f"{k} {p[k]:g}"
+        ex = p.get("extra") or {}
+        if int(float(ex.get("species", 1))) > 1:
+            parts["species"] = f"{ex['species']} species"
+        if ex.get("r_dist", "one") != "one":
+            parts["r_dist"] = f"{ex['r_dist']} radii"
+        if ex.get("q_dist", "fixed") != "fixed":
+            parts["q_dist"] = f"{ex['q_dist']} charges"
+    return ", ".join(parts.values())
+
+
 def _label(key):
     rp, U0, gamma = key
-    return f"r_p = {rp:g} um, U0 = {U0:g} m/s, gamma = {gamma:g} mJ/m2"
+    pre = f"{PAPER['material']}: " if PAPER["material"] else ""
+    return pre + f"r_p = {rp:g} um, U0 = {U0:g} m/s, gamma = {gamma:g} mJ/m2"
 
 
 def _ok(results):
@@ -177,7 +207,8 @@ def packings_panel(results: list[dict], out: Path) -> Path | None:
         ax.set_title(f"({lab}) " + ax.get_title(), fontsize=7)
     z_colorbar(fig, axes)
     fig.suptitle(f"{_label(key)}. Paper (Fig. 2, Table 2; N = 2000, L = 28 r_p): neutral "
-                 f"phi = {paper.TABLE2[0][1]}, <Z> = {paper.TABLE2[0][2]}", fontsize=8)
+                 f"phi = {paper.TABLE2[0][1]}, <Z> = {paper.TABLE2[0][2]}" if _paper() else
+                 _label(key), fontsize=8)
     return save(fig, Path(out) / "packings.png", picks.drop(columns=["dir"]), tight=False)
 
 
@@ -265,8 +296,9 @@ def force_network(panels: list[tuple[str, Path, Path]], params: dict, out: Path,
                Line2D([], [], color=(0.1, 0.25, 0.9), lw=2, label="tensile (F_n < 0)"),
                Line2D([], [], color="k", lw=4.3, label=f"|F_n| = {wmax / FC:.3g} F_C (widest)")]
     fig.legend(handles=handles, loc="lower center", ncol=3, fontsize=7, frameon=False)
-    fig.suptitle("Normal contact forces in a slice of width 3 r_p (the paper's Fig. 6; paper: "
-                 f"|F_n / F_C| < {paper.FORCE_RANGE})", fontsize=9)
+    fig.suptitle("Normal contact forces in a slice of width 3 r_p" + (
+        f" (the paper's Fig. 6; paper: |F_n / F_C| < {paper.FORCE_RANGE})" if _paper()
+        else f" ({PAPER['material']})"), fontsize=9)
     fig.tight_layout(rect=(0, 0.05, 1, 0.95))
     return save(fig, Path(out) / name, pd.concat(frames), tight=False)
 
@@ -283,7 +315,8 @@ def phi_vs_q(results, out: Path):
     s = tables.summary(tables.runs_frame(ok))
     fig = new_figure(5.2, 4.0)
     ax = fig.add_subplot(111)
-    ax.axhspan(*paper.PHI0_RANGE, color="0.88", label="paper: neutral phi_0 = 0.270-0.363")
+    if _paper():
+        ax.axhspan(*paper.PHI0_RANGE, color="0.88", label="paper: neutral phi_0 = 0.270-0.363")
     for key, g in s.groupby(["rp_um", "U0", "gamma_mJ"]):
         ax.errorbar(g["q"], g["phi"], g["phi_sd"].fillna(0), marker="o", capsize=3,
                     label=_label(key) + f" (N = {g['N'].iloc[0]:.0f})")
@@ -304,8 +337,9 @@ def phi_vs_q(results, out: Path):
         ax.set_yscale("log")
         ax.text(0.5, 0.5, "no charged run looser than its neutral run\n(phi_0/phi - 1 <= 0)",
                 transform=ax.transAxes, ha="center", va="center", fontsize=9)
-        ax.axhline(paper.MAX_RELATIVE_DECREASE, color="0.5", ls="--", lw=0.8,
-                   label="paper: maximum phi_0/phi - 1 = 0.4")
+        if _paper():
+            ax.axhline(paper.MAX_RELATIVE_DECREASE, color="0.5", ls="--", lw=0.8,
+                       label="paper: maximum phi_0/phi - 1 = 0.4")
         ax.set_xlabel("q / e0")
         ax.set_ylabel("phi_0 / phi - 1")
         ax.legend(fontsize=6)
@@ -324,10 +358,12 @@ def phi_vs_q(results, out: Path):
         # the paper's slope 2 through the geometric centre of our points
         lq, le = np.log10(g["q"]).mean(), np.log10(g["expansion"]).mean()
         qq = np.array([g["q"].min() / 1.5, g["q"].max() * 1.5])
-        ax.loglog(qq, 10 ** (le + paper.EXPANSION_SLOPE * (np.log10(qq) - lq)), **PAPER_STYLE)
-    ax.plot([], [], **PAPER_STYLE, label="paper: slope 2 (through our points)")
-    ax.axhline(paper.MAX_RELATIVE_DECREASE, color="0.5", ls="--", lw=0.8,
-               label="paper: maximum phi_0/phi - 1 = 0.4")
+        if _paper():
+            ax.loglog(qq, 10 ** (le + paper.EXPANSION_SLOPE * (np.log10(qq) - lq)), **PAPER_STYLE)
+    if _paper():
+        ax.plot([], [], **PAPER_STYLE, label="paper: slope 2 (through our points)")
+        ax.axhline(paper.MAX_RELATIVE_DECREASE, color="0.5", ls="--", lw=0.8,
+                   label="paper: maximum phi_0/phi - 1 = 0.4")
     ax.set_xlabel("q / e0")
     ax.set_ylabel("phi_0 / phi - 1")
     ax.legend(fontsize=6)
@@ -403,7 +439,8 @@ def rdf(results, out: Path, nbins=150):
     ax.set_xlabel("r / 2r_p")
     ax.set_ylabel("g(r)")
     ax.set_xlim(0.8, 3.0)
-    ax.set_title(_label(key) + "\npaper (Fig. 4): the sqrt 3 peak vanishes when charged", fontsize=8)
+    ax.set_title(_label(key) + ("\npaper (Fig. 4): the sqrt 3 peak vanishes when charged"
+                                if _paper() else ""), fontsize=8)
     ax.legend(fontsize=7)
     return save(fig, Path(out) / "rdf.png", pd.DataFrame(data))
 
@@ -429,8 +466,9 @@ def fZ(results, out: Path):
         ax.axvline(Zm, color=line.get_color(), lw=0.6, ls="--")
         rows.append(dict(rp_um=rp, U0=U0, gamma_mJ=gam, q=q, runs=len(rs), Z=Zm,
                          **{f"f{z}": v for z, v in enumerate(f)}))
-    ax.axvline(paper.TABLE2[0][2], **PAPER_STYLE)
-    ax.plot([], [], **PAPER_STYLE, label=f"paper Table 2 neutral <Z> = {paper.TABLE2[0][2]}")
+    if _paper():
+        ax.axvline(paper.TABLE2[0][2], **PAPER_STYLE)
+        ax.plot([], [], **PAPER_STYLE, label=f"paper Table 2 neutral <Z> = {paper.TABLE2[0][2]}")
     ax.set_xlabel("Z (last bin of compute coord/dist: Z >= zmax)")
     ax.set_ylabel("f(Z)")
     ax.set_xlim(-0.5, 10.5)
@@ -456,9 +494,10 @@ def force_pdf(panels: list[tuple[str, Path]], params: dict, out: Path, name="for
         h, _ = np.histogram(v, bins=edges, density=True)
         ax.plot(c, h, label=f"{label} ({len(v)} contacts, mean {v.mean():+.4f})")
         data[f"pdf {label}"] = h
-    for x in (-paper.FORCE_RANGE, paper.FORCE_RANGE):
-        ax.axvline(x, **PAPER_STYLE)
-    ax.plot([], [], **PAPER_STYLE, label="paper: |F_n / F_C| < 0.1")
+    if _paper():
+        for x in (-paper.FORCE_RANGE, paper.FORCE_RANGE):
+            ax.axvline(x, **PAPER_STYLE)
+        ax.plot([], [], **PAPER_STYLE, label="paper: |F_n / F_C| < 0.1")
     ax.set_xlabel("F_n / F_C  (> 0 compressive)")
     ax.set_ylabel("pdf")
     ax.legend(fontsize=6)
@@ -541,8 +580,9 @@ def _phi_Z_vs(df, col: str, xlabel: str, path: Path):
     a1, a2 = fig.add_subplot(211), fig.add_subplot(212, sharex=None)
     sc = a1.scatter(df[col], df["phi"], c=df["q"], cmap="plasma")
     a2.scatter(df[col], df["Z"], c=df["q"], cmap="plasma")
-    a1.axhline(paper.ALP_PHI, **PAPER_STYLE, label="paper: ALP limit phi = 1/8")
-    a2.axhline(paper.ALP_Z, **PAPER_STYLE, label="paper: ALP limit <Z> = 2")
+    if _paper():
+        a1.axhline(paper.ALP_PHI, **PAPER_STYLE, label="paper: ALP limit phi = 1/8")
+        a2.axhline(paper.ALP_Z, **PAPER_STYLE, label="paper: ALP limit <Z> = 2")
     for ax in (a1, a2):
         ax.set_xscale("log")
         ax.axvline(1.0, color="0.6", lw=0.8, ls="--")
@@ -558,9 +598,10 @@ def _phase_diagram(df, out: Path):
     fig = new_figure(5.2, 4.8)
     ax = fig.add_subplot(111)
     sc = ax.scatter(df["Z"], df["phi"], c=df["q"], cmap="plasma", label="this package's runs")
-    ax.plot([paper.ALP_Z], [paper.ALP_PHI], "k*", ms=12, label="paper: ALP (Z = 2, phi = 1/8)")
-    ax.plot([paper.TABLE2[0][2]], [paper.TABLE2[0][1]], "ks", mfc="none", ms=8,
-            label="paper Table 2 neutral packing")
+    if _paper():
+        ax.plot([paper.ALP_Z], [paper.ALP_PHI], "k*", ms=12, label="paper: ALP (Z = 2, phi = 1/8)")
+        ax.plot([paper.TABLE2[0][2]], [paper.TABLE2[0][1]], "ks", mfc="none", ms=8,
+                label="paper Table 2 neutral packing")
     ax.set_xlim(1.5, 6.5)
     ax.set_ylim(0.1, 0.65)
     ax.set_xlabel("<Z>")
@@ -600,12 +641,13 @@ def conventions(results, out: Path):
         ax.set_xticks(x)
         ax.set_xticklabels([f"{a:g} um, {b:g} m/s\n{c:g} mJ/m2\nAd = {ad:.2g}" for a, b, c, ad in
                             zip(t["rp_um"], t["U0"], t["gamma_mJ"], t["Ad"])], fontsize=5)
-    axes[0].axhspan(*paper.PHI0_RANGE, color="0.88", zorder=0,
-                    label=f"paper: phi_0 = {paper.PHI0_RANGE[0]}-{paper.PHI0_RANGE[1]}")
-    axes[0].axhline(paper.TABLE2[0][1], **PAPER_STYLE,
-                    label=f"paper Table 2 (2 um, 1 m/s): {paper.TABLE2[0][1]}")
-    axes[1].axhline(paper.TABLE2[0][2], **PAPER_STYLE,
-                    label=f"paper Table 2 (2 um, 1 m/s): {paper.TABLE2[0][2]}")
+    if _paper():
+        axes[0].axhspan(*paper.PHI0_RANGE, color="0.88", zorder=0,
+                        label=f"paper: phi_0 = {paper.PHI0_RANGE[0]}-{paper.PHI0_RANGE[1]}")
+        axes[0].axhline(paper.TABLE2[0][1], **PAPER_STYLE,
+                        label=f"paper Table 2 (2 um, 1 m/s): {paper.TABLE2[0][1]}")
+        axes[1].axhline(paper.TABLE2[0][2], **PAPER_STYLE,
+                        label=f"paper Table 2 (2 um, 1 m/s): {paper.TABLE2[0][2]}")
     axes[0].set_ylabel("phi")
     axes[1].set_ylabel("<Z>")
     axes[0].set_ylim(0.2, None)
@@ -623,15 +665,21 @@ def conventions(results, out: Path):
 # ---- everything -----------------------------------------------------------------------------
 
 def all_figures(results, out: Path, table2_rows: list[dict] | None = None,
-                table2_dir: Path | None = None, jobs: int = 1) -> list[Path]:
+                table2_dir: Path | None = None, jobs: int = 1,
+                paper_notes: bool | None = None) -> list[Path]:
     """Every figure the given runs allow; returns the PNG paths written. jobs > 1: drawn by
-    that many processes (each figure is independent of the others)."""
+    that many processes (each figure is independent of the others). paper_notes: draw the
+    paper's values and annotations (None: when the runs are of the paper's material with one
+    kind of particle); otherwise the series are labelled with the runs' material."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     results = [r for r in results if r.get("complete")]
     if not results:
         log.warning("figures: no finished runs")
         return []
+    mat = material_label(results)
+    PAPER["on"] = (not mat) if paper_notes is None else paper_notes
+    PAPER["material"] = mat
     tasks = figure_tasks(results, out, table2_rows)
     if jobs > 1 and len(tasks) > 1:
         # fork: the workers start at once with this process's modules (no re-import)

@@ -287,3 +287,78 @@ def analyse(snap: Snapshot, rp: float, zlo_rp=4.0, top_rp=6.0, tol=0.0,
     cs = coordination_stats(snap, zlo, zhi, tol, zmax)
     out.update({k: cs[k] for k in ("Z", "fZ", "n_slab")})
     return out
+
+
+# ---- mixtures and size spreads --------------------------------------------------------------
+
+def size_classes(radii: np.ndarray, nclass: int = 4) -> np.ndarray:
+    """Class edges of a set of radii: each distinct radius when there are at most 6 (a discrete
+    population), else nclass classes of equal numbers (quantiles)."""
+    u = np.unique(radii)
+    if len(u) <= 6:
+        mid = 0.5 * (u[1:] + u[:-1])
+        return np.concatenate([[u[0] * 0.999], mid, [u[-1] * 1.001]])
+    e = np.quantile(radii, np.linspace(0.0, 1.0, nclass + 1))
+    e[0] *= 0.999
+    e[-1] *= 1.001
+    return e
+
+
+def by_class(snap: Snapshot, population: dict | None, zlo: float, zhi: float, tol: float = 0.0,
+             zmax: int = ZMAX_DEFAULT) -> dict:
+    """<Z> and f(Z) of the slab's particles per species (the dump's type) and per size class
+    (size_classes of each species' radii in the slab), and the mean diameter of the slab:
+    {'mean_diameter', 'classes': [{'species', 'r_lo', 'r_hi', 'n', 'Z', 'fZ'}, ...]}."""
+    if zhi <= zlo:
+        return {"classes": []}
+    Z = coordination(snap, tol)
+    sel = (snap["z"] >= zlo) & (snap["z"] <= zhi)
+    types = snap["type"].astype(int) if "type" in snap.cols else np.ones(snap.n, dtype=int)
+    rad = snap["radius"]
+    rows = []
+    for t in np.unique(types[sel]):
+        st = sel & (types == t)
+        rows.append({"species": int(t), "r_lo": float(rad[st].min()), "r_hi": float(rad[st].max()),
+                     "n": int(st.sum()), "Z": float(Z[st].mean()),
+                     "fZ": fz_histogram(Z[st], zmax).tolist(), "class": "all"})
+        edges = size_classes(rad[st])
+        for k in range(len(edges) - 1):
+            sk = st & (rad >= edges[k]) & (rad < edges[k + 1])
+            if sk.any():
+                rows.append({"species": int(t), "r_lo": float(rad[sk].min()),
+                             "r_hi": float(rad[sk].max()), "n": int(sk.sum()),
+                             "Z": float(Z[sk].mean()), "fZ": fz_histogram(Z[sk], zmax).tolist(),
+                             "class": k + 1})
+    return {"mean_diameter": float(2.0 * rad[sel].mean()) if sel.any() else float("nan"),
+            "classes": rows}
+
+
+def rdf_contact(snap: Snapshot, zlo: float, zhi: float, xmax: float = 3.0, nbins: int = 150,
+                partners: int = 256, seed: int = 0):
+    """g as a function of x = r_ij / (r_i + r_j) (contact at x = 1 for every pair) of the
+    particles with centres in [zlo, zhi]: pair counts in bins of x over the ideal-gas count of the
+    same slab, for which a reference i and a partner j at distance x (r_i + r_j) add
+    rho_s 2 pi r |[z_i - r, z_i + r] n [zlo, zhi]| dr (rdf_slab's zone), averaged over the
+    partners' radii (a random subset of `partners`). A monodisperse packing gives rdf_slab with
+    r = 2 r_p x. Returns (x centres, g)."""
+    sel = np.flatnonzero((snap["z"] >= zlo) & (snap["z"] <= zhi))
+    sub = Snapshot(snap.step, snap.box, {k: v[sel] for k, v in snap.cols.items()})
+    rs = sub["radius"]
+    pairs, dist = pair_distances(sub, xmax * 2.0 * rs.max())
+    x = dist / (rs[pairs[:, 0]] + rs[pairs[:, 1]])
+    edges = np.linspace(0.0, xmax, nbins + 1)
+    counts = np.histogram(x, bins=edges)[0] * 2.0
+    xc = 0.5 * (edges[:-1] + edges[1:])
+    dx = edges[1] - edges[0]
+    rho_s = len(sel) / (snap.lx * snap.ly * (zhi - zlo))
+    rng = np.random.default_rng(seed)
+    pj = rs if len(rs) <= partners else rng.choice(rs, partners, replace=False)
+    sig = rs[:, None] + pj[None, :]
+    z = sub["z"][:, None]
+    ideal = np.empty(nbins)
+    for k in range(nbins):
+        r = xc[k] * sig
+        ov = np.clip(np.minimum(z + r, zhi) - np.maximum(z - r, zlo), 0.0, None)
+        ideal[k] = rho_s * (2.0 * math.pi * r * ov * dx * sig).mean(axis=1).sum()
+    g = np.where(ideal > 0, counts / np.where(ideal > 0, ideal, 1.0), 0.0)
+    return xc, g

@@ -74,7 +74,7 @@ class DepositionParams:
         """A file-system friendly name, unique for the parameters: the swept ones always, the
         far field of a charged run, and every other one that differs from its default."""
         base = f"{series_name(self.rp, self.U0, self.gamma)}_q{self.q:g}_N{self.N}_s{self.seed}"
-        if self.q:
+        if self.q or (self.extra and self._population_charged()):
             base += f"_{self.farfield}"
         tags = {k: getattr(self, k) for k in MATERIAL
                 if k != "farfield" and getattr(self, k) != getattr(DepositionParams, k)}
@@ -82,7 +82,10 @@ class DepositionParams:
         for k in sorted(tags):
             v = tags[k]
             base += f"_{k}{v:g}" if isinstance(v, float) else f"_{k}{v}"
-        return base.replace("/", "-")
+        return base.replace("/", "-").replace(" ", ",")
+
+    def _population_charged(self) -> bool:
+        return population_charged(self.deck_vars())
 
     # derived -------------------------------------------------------------------------------
     @property
@@ -100,6 +103,25 @@ class DepositionParams:
         d = dimensionless(self.gamma, self.rho, self.U0, self.rp, self.q, K_eff=K)
         d["K_eff"] = K
         return d
+
+
+def population_charged(v: dict) -> bool:
+    """in.deposition's rule (its variables pop, chg<s>): a particle population (more than one
+    species, a size or a charge rule) any species of which is charged: q != 0 (but with
+    q_dist area), q_sigma != 0 (but with q_dist fixed), q_sd != 0 with q_dist gauss; a species
+    s > 1 reads name_s, else species 1's value."""
+    n = int(float(v.get("species", 1)))
+    if n == 1 and v.get("r_dist", "one") == "one" and v.get("q_dist", "fixed") == "fixed":
+        return False
+    for s in range(1, n + 1):
+        def g(name, default):
+            key = f"{name}_{s}"
+            return v[key] if s > 1 and key in v else v.get(name, default)
+        qd = g("q_dist", "fixed")
+        q, sig, sd = (float(g(k, 0.0)) for k in ("q", "q_sigma", "q_sd"))
+        if (qd != "area" and q != 0) or (qd != "fixed" and sig != 0) or (qd == "gauss" and sd != 0):
+            return True
+    return False
 
 
 def series_name(rp: float, U0: float, gamma: float) -> str:

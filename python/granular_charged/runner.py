@@ -25,7 +25,7 @@ import threading
 import time
 from pathlib import Path
 
-from . import packing
+from . import packing, population
 from .deckfile import deck_path, deck_variables
 from .lammps_build import LammpsBuild
 from .params import DepositionParams, ParamError, coulomb_to_adhesion
@@ -179,6 +179,20 @@ def trim_dump(path: Path, before_step: int):
     os.replace(tmp, path)
 
 
+def parse_progress(line: str) -> dict | None:
+    """{'k', 'N', 'step', 'elapsed', 'eta'} of a GC PROGRESS line of in.deposition:
+    'GC PROGRESS k / N particles, step S, elapsed T s, eta T s'."""
+    w = line.replace(",", " ").split()
+    try:
+        out = {"k": int(float(w[2])), "N": int(w[4]), "step": int(w[7]),
+               "elapsed": float(w[9]), "eta": float(w[12])}
+    except (IndexError, ValueError):
+        return None
+    # the rain's line goes on during the settling with the stop rule's kinetic energy
+    out["kerel"] = float(w[15]) if len(w) > 15 and w[14] == "kerel" else None
+    return out
+
+
 class Runner:
     """Runs decks in folders with one LAMMPS build, ``np_ranks`` MPI ranks per run;
     ``checkpoint`` > 0: plane and sequential depositions leave a restart point every that many
@@ -198,6 +212,7 @@ class Runner:
         self.checkpoint = checkpoint
         self._slots = contextlib.nullcontext()
         self._stopped = False
+        self.show_progress = False     # a tqdm bar per deposition (run; a sweep of one job)
 
     @contextlib.contextmanager
     def at_most(self, jobs: int):
@@ -241,8 +256,11 @@ class Runner:
                     raise RunError(f"{workdir}: not started (the study was stopped)")
                 t0 = time.monotonic()
                 ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-                r = subprocess.run(cmd, env=env, capture_output=True, text=True,
-                                   timeout=self.timeout)
+                if self.show_progress and kind == "deposition":
+                    r = self._watch(cmd, env, workdir, kind)
+                else:
+                    r = subprocess.run(cmd, env=env, capture_output=True, text=True,
+                                       timeout=self.timeout)
                 wall = time.monotonic() - t0
                 ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         res_file = workdir / "lammps.json"
@@ -252,6 +270,9 @@ class Runner:
             stop = [ln for ln in text.splitlines() if ln.startswith("GC CHECKPOINT STOP")]
             if r.returncode == 0 and stop:
                 raise RunError(f"{workdir}: {stop[-1][3:]}; run it again to go on from there")
+            inner = workdir / "log.inject.lammps"     # the one-by-one loops' runs
+            if inner.exists() and "GC RESULT" not in text:
+                text += "\n" + inner.read_text(errors="replace")
             tail = "\n".join(text.splitlines()[-15:])
             raise RunError(f"LAMMPS run in {workdir} failed (exit {r.returncode}):\n{tail}\n"
                            f"{r.stderr[-1500:]}")
@@ -260,6 +281,74 @@ class Runner:
         # CPU of all ranks; approximate when runs overlap (jobs > 1)
         out["cpu_s"] = (ru1.ru_utime - ru0.ru_utime) + (ru1.ru_stime - ru0.ru_stime)
         return out
+
+    def _watch(self, cmd, env, workdir: Path, kind: str) -> subprocess.CompletedProcess:
+        """Run the child, following the GC PROGRESS lines of its log.lammps (particles made / N)
+        with a tqdm bar when self.show_progress (a deposition); the timeout kills it."""
+        import tempfile
+        with tempfile.TemporaryFile("w+") as fo, tempfile.TemporaryFile("w+") as fe:
+            proc = subprocess.Popen(cmd, env=env, stdout=fo, stderr=fe, text=True)
+            bar = None
+            if self.show_progress and kind == "deposition":
+                from tqdm import tqdm
+                bar = tqdm(total=None, unit="particle", desc=Path(workdir).name[:40],
+                           leave=False, dynamic_ncols=True)
+            logf, pos, t0 = Path(workdir) / "log.lammps", 0, time.monotonic()
+            try:
+                while True:
+                    try:
+                        rc = proc.wait(timeout=1.0)
+                        break
+                    except subprocess.TimeoutExpired:
+                        pass
+                    if self.timeout and time.monotonic() - t0 > self.timeout:
+                        proc.kill()
+                        proc.wait()
+                        raise subprocess.TimeoutExpired(cmd, self.timeout)
+                    if bar is not None:
+                        pos = self._progress(logf, pos, bar)
+            except BaseException:
+                if proc.poll() is None:
+                    proc.kill()
+                    proc.wait()
+                raise
+            finally:
+                if bar is not None:
+                    bar.close()
+            fo.seek(0)
+            fe.seek(0)
+            return subprocess.CompletedProcess(cmd, rc, fo.read(), fe.read())
+
+    @staticmethod
+    def _progress(logf: Path, pos: int, bar) -> int:
+        """Read log.lammps from byte pos; move the bar to the last GC PROGRESS line's count."""
+        try:
+            with open(logf, "rb") as fh:
+                fh.seek(pos)
+                chunk = fh.read()
+        except OSError:
+            return pos
+        end = chunk.rfind(b"\n") + 1
+        last = settle = None
+        for line in chunk[:end].decode(errors="replace").splitlines():
+            if line.startswith("GC PROGRESS "):
+                last = parse_progress(line)
+            elif line.startswith("GC SETTLE "):
+                settle = line.replace(",", " ").split()
+        if last is not None:
+            bar.total = last["N"]
+            bar.n = last["k"]
+            post = {"step": last["step"]}
+            if last.get("kerel") is not None and last["k"] >= last["N"]:
+                post["settling: kerel"] = f"{last['kerel']:.2g}"
+            bar.set_postfix(post, refresh=False)
+        if settle is not None:
+            # the last settling: the stop rule's kinetic energy against its threshold
+            bar.set_postfix({"step": settle[3], "settling: kerel": f"{settle[5]} -> {settle[8].rstrip(')')}",
+                             "moving": settle[-1]}, refresh=False)
+        if last is not None or settle is not None:
+            bar.refresh()
+        return pos + end
 
     # ---- one deposition -------------------------------------------------------------------
     def workdir(self, p: DepositionParams, root: Path) -> Path:
@@ -302,7 +391,7 @@ class Runner:
         if wd.exists() and point is None:
             log.info("%s: incomplete run folder (interrupted?), running it again", p.key())
             shutil.rmtree(wd)
-        if p.q and not self.build.capabilities["coul/fmm"]:
+        if population.is_charged(p.deck_vars()) and not self.build.capabilities["coul/fmm"]:
             raise RunError(f"{p.key()}: charged runs need fix coul/fmm, absent from {self.build.path}")
         variables = p.deck_vars()
         variables["out"] = "."
@@ -325,6 +414,8 @@ class Runner:
             raise RunError(f"{p.key()}: the analysis of {wd} failed: {type(e).__name__}: {e}") from e
         res["tracer"] = tracer
         res["np"] = self.np_ranks
+        log.info("%s: injection protocol %s%s", p.key(), res["protocol"],
+                 " (auto)" if p.extra.get("inject", "auto") == "auto" else "")
         if len(pieces) > 1:
             res["pieces"] = pieces
         write_json(wd / "result.json", res)
@@ -389,7 +480,12 @@ class Runner:
             "inserted": lmp["inserted"], "natoms": lmp["atoms"], "lost": lmp["lost"],
             "flying": lmp["flying"], "wall_s": lmp["wall_s"], "cpu_s": lmp["cpu_s"],
             "image": lmp.get("image"),
+            # the protocol the deck used (its GC PROTOCOL line), and the population it drew
+            "protocol": lmp.get("inject") or population.protocol(p.deck_vars()),
+            "population": population.describe(p.deck_vars()),
         }
+        if population.is_population(p.deck_vars()):
+            res["python"].update(packing.by_class(snap, res["population"], py["zlo"], py["zhi"]))
         warnings = [ana["warning"]] if "warning" in ana else []
         if lmp["inserted"] < p.N:
             # inject sequential stops when the bed's charge turns the next particle back

@@ -16,7 +16,10 @@ def _run(cli, tmp_path, q, *extra, size=SMALL):
     cli(["-q", "run", "--out", tmp_path, "--q", q, *size, *extra], cwd=tmp_path)
     (wd,) = [d for d in Path(tmp_path).iterdir() if d.is_dir()]
     res = json.loads((wd / "result.json").read_text())
-    log = (wd / "log.lammps").read_text()
+    # the one-by-one loop's runs are in log.inject.lammps, the rest (and the warnings) in
+    # log.lammps: read in the order they were written
+    inner = wd / "log.inject.lammps"
+    log = (inner.read_text() if inner.exists() else "") + (wd / "log.lammps").read_text()
     return res, log
 
 
