@@ -13,8 +13,10 @@
    marshall_kernels.h, and the wall's zero velocity, spin and radius enter the same arithmetic),
    so exact equality is expected and asserted.
 
-   Checked by changing the fused loop only: the damping force's factor (-damp_prefactor * vnnr
-   -> -1.000001 damp_prefactor * vnnr) fails every equivalence test. */
+   Checked by changing one factor of the fused loop by 1e-6 at a time: the normal damping
+   force, the sliding limit, the twisting limit, the rolling limit and the torque's lever arm
+   each fail SameAsWallGranMarshallSet, SameAsWallGranYPlanes and RestartAcrossStyles (the
+   rolling limit also RunReachesTheLimits). */
 #include "gc_testing.h"
 
 #include "fix_wall_gran.h"
