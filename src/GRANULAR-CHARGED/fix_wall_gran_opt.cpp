@@ -98,8 +98,7 @@ const MK::JKRScales &FixWallGranOpt::scales_of(double reff)
 {
   if (reff != scales_radius) {
     scales_radius = reff;
-    scales = MK::JKRScales();
-    MK::use_jkr_scales(scales, reff, coeffs.gamma, coeffs.emix);
+    scales = MK::jkr_scales(reff, coeffs.gamma, coeffs.emix);
   }
   return scales;
 }

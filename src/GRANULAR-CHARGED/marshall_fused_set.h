@@ -12,7 +12,7 @@
 // damping marshall or marshall/printed + tangential marshall, rolling none | marshall |
 // marshall/particle, twisting none | marshall/jkr, heat none, no limit_damping (a cohesive
 // model cannot use it anyway) and no synchronized_verlet (LAMMPS 4Jul2026; tangential marshall
-// then runs mindlin's code). The same decision as pair_style granular/opt's, for one model.
+// then runs mindlin's code). pair_style granular/opt and fix wall/gran/opt both decide here.
 
 #ifndef LMP_GC_MARSHALL_FUSED_SET_H
 #define LMP_GC_MARSHALL_FUSED_SET_H

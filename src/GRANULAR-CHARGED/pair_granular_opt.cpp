@@ -9,11 +9,6 @@
 
 #include "pair_granular_opt.h"
 
-#include "gran_sub_mod_damping_marshall.h"
-#include "gran_sub_mod_normal_jkr_marshall.h"
-#include "gran_sub_mod_rolling_marshall.h"
-#include "gran_sub_mod_tangential_marshall.h"
-#include "gran_sub_mod_twisting_marshall_jkr.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -108,39 +103,12 @@ void PairGranularOpt::setup_fused()
 {
   fused.assign(nmodels, FusedMarshall());
   for (int n = 0; n < nmodels; n++) {
-    GranularModel *model = models_list[n];
-    auto *normal = dynamic_cast<GranSubModNormalJKRMarshall *>(model->normal_model);
-    auto *damping = dynamic_cast<GranSubModDampingMarshall *>(model->damping_model);
-    auto *tangential = dynamic_cast<GranSubModTangentialMarshall *>(model->tangential_model);
-    auto *rolling = dynamic_cast<GranSubModRollingMarshall *>(model->rolling_model);
-    auto *twisting = dynamic_cast<GranSubModTwistingMarshallJKR *>(model->twisting_model);
-    const bool rolling_ok = rolling || model->rolling_model->name == "none";
-    const bool twisting_ok = twisting || model->twisting_model->name == "none";
-    bool ok = normal && damping && tangential && rolling_ok && twisting_ok &&
-        model->sub_models[HEAT]->name == "none" && !model->limit_damping;
-#if GC_LAMMPS_VERSION >= 20260704
-    ok = ok && !model->synchronized_verlet;
-#endif
-    if (!ok) continue;
-
     FusedMarshall &f = fused[n];
+    if (!MarshallFusedSet::of_model(models_list[n], f)) continue;
     f.on = true;
-    f.emix = normal->get_emix();
-    f.gamma = normal->get_surface_energy();
-    f.alpha = damping->get_alpha();
-    f.mass_factor = damping->get_mass_factor();
-    f.k_t = tangential->get_k();
-    f.mu = tangential->get_mu();
-    f.rolling = rolling != nullptr;
-    if (rolling) {
-      f.theta_crit = rolling->get_theta_crit();
-      f.roll_radius_factor = rolling->get_pair_radius_factor();
-    }
-    f.twisting = twisting != nullptr;
-
-    hist_tangential = model->tangential_model->history_index;
-    hist_rolling = model->rolling_model->history_index;
-    hist_twisting = model->twisting_model->history_index;
+    hist_tangential = f.hist_tangential;
+    hist_rolling = f.hist_rolling;
+    hist_twisting = f.hist_twisting;
   }
   // a heat model needs PairGranular's heat-flow bookkeeping, which the fused loop does not do
   bool any_fused = false;

@@ -16,6 +16,7 @@ PairStyle(granular/opt,PairGranularOpt);
 #ifndef LMP_PAIR_GRANULAR_OPT_H
 #define LMP_PAIR_GRANULAR_OPT_H
 
+#include "marshall_fused_set.h"
 #include "marshall_kernels.h"
 #include "pair_granular.h"
 
@@ -48,18 +49,8 @@ class PairGranularOpt : public PairGranular {
 
  protected:
   // coefficients of one model for the fused kernel, copied from its sub-models
-  struct FusedMarshall {
+  struct FusedMarshall : MarshallFusedSet::Coeffs {
     bool on = false;                  // the model is of the fused set
-    double emix = 0.0;                // E*
-    double gamma = 0.0;               // surface energy
-    double alpha = 0.0;               // damping alpha(e)
-    double mass_factor = 2.0;         // damping marshall 2, marshall/printed 1
-    double k_t = 0.0;                 // 8 G*: tangential stiffness per unit contact radius
-    double mu = 0.0;                  // sliding friction coefficient
-    bool rolling = false;             // rolling marshall[/particle] defined
-    double theta_crit = 0.0;          // critical rolling angle
-    double roll_radius_factor = 1.0;  // rolling limit at theta_crit x this x R_eff
-    bool twisting = false;            // twisting marshall/jkr defined
   };
   std::vector<FusedMarshall> fused;      // one per entry of models_list
   bool fused_ready;                      // false after init_style(): rebuild before compute()
