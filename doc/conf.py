@@ -80,5 +80,61 @@ def _repository_path(app, env, node, contnode):
     return ref
 
 
+# The style pages link LAMMPS's own pages as LAMMPS's doc/src does (:doc:`fix <fix>`), so that
+# they can be copied there unchanged.  In this manual those links go to LAMMPS's online manual;
+# only the names listed here do, so that a mistyped link to one of our own pages still warns.
+LAMMPS_PAGES = {
+    "atom_style", "comm_modify", "compute", "compute_pair_local", "compute_reduce",
+    "compute_coord_atom", "compute_rdf", "create_atoms", "dump", "fix", "fix_deposit",
+    "fix_freeze", "fix_modify", "fix_move", "fix_neigh_history", "fix_nve_sphere", "fix_pour",
+    "fix_rigid", "fix_wall_gran", "fix_wall_gran_region", "kspace_style", "minimize",
+    "neigh_modify", "neighbor", "newton", "package", "pair_coeff", "pair_granular",
+    "pair_style", "processors", "read_restart", "restart", "run", "run_style", "suffix",
+    "thermo_style", "units", "variable", "write_restart", "Build_package", "Speed_opt",
+    "fix_efield", "fix_scafacos", "balance", "Howto_output", "compute_contact_atom",
+    "compute_fabric", "compute_voronoi_atom", "pair_hybrid", "fix_ave_time", "set", "displace_atoms",
+}
+
+
+def _lammps_page(app, env, node, contnode):
+    if node.get("reftype") != "doc":
+        return None
+    target = node.get("reftarget", "")
+    if target not in LAMMPS_PAGES:
+        return None
+    from docutils import nodes
+
+    ref = nodes.reference("", "", internal=False, refuri=f"https://docs.lammps.org/{target}.html")
+    ref += contnode
+    return ref
+
+
+# LAMMPS's doc/src writes input lines as ".. code-block:: LAMMPS"; Pygments has no lexer of
+# that name, so a small one here: comments, variables, numbers, the command word of a line.
+def _lammps_lexer():
+    from pygments.lexer import RegexLexer, bygroups
+    from pygments.token import Comment, Keyword, Name, Number, Punctuation, String, Text
+
+    class LAMMPSLexer(RegexLexer):
+        name = "LAMMPS"
+        aliases = ["lammps"]
+        tokens = {
+            "root": [
+                (r"#.*?$", Comment),
+                (r"^(\s*)([a-z_]+)", bygroups(Text, Keyword)),
+                (r"\$\{[^}]*\}|\$[A-Za-z]|v_\w+|[cf]_\w+(\[[0-9*]+\])?", Name.Variable),
+                (r'"[^"]*"', String),
+                (r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?\b", Number),
+                (r"&\s*$", Punctuation),
+                (r"\s+", Text),
+                (r"\S+?", Text),
+            ]
+        }
+
+    return LAMMPSLexer
+
+
 def setup(app):
+    app.add_lexer("LAMMPS", _lammps_lexer())
     app.connect("missing-reference", _repository_path)
+    app.connect("missing-reference", _lammps_page)
