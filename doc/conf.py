@@ -92,7 +92,7 @@ LAMMPS_PAGES = {
     "pair_style", "processors", "read_restart", "restart", "run", "run_style", "suffix",
     "thermo_style", "units", "variable", "write_restart", "Build_package", "Speed_opt",
     "fix_efield", "fix_scafacos", "balance", "Howto_output", "compute_contact_atom",
-    "compute_fabric", "compute_voronoi_atom", "pair_hybrid", "fix_ave_time", "set", "displace_atoms",
+    "compute_fabric", "kspace_modify", "pair_coul", "dielectric", "pair_modify", "compute_voronoi_atom", "pair_hybrid", "fix_ave_time", "set", "displace_atoms",
 }
 
 
