@@ -30,7 +30,7 @@ root_doc = "index"
 # Not pages of the manual: the kept runs and their notes (doc/data), the figures' folder
 # (images are included by the pages that show them), and doc/README.md, the short pointer
 # to this manual that a reader of the repository sees on its own.
-exclude_patterns = ["data", "figures", "_ext", "README.md", "_build", "Thumbs.db", ".DS_Store"]
+exclude_patterns = ["data", "figures", "_ext", "_static", "README.md", "_build", "Thumbs.db", ".DS_Store"]
 
 # Markdown: plain CommonMark plus tables; the pages write their equations as text, so no
 # "$...$" maths (a shell variable such as ${zlo} must stay text). Anchors for "#section"
@@ -38,10 +38,16 @@ exclude_patterns = ["data", "figures", "_ext", "README.md", "_build", "Thumbs.db
 myst_enable_extensions = []
 myst_heading_anchors = 4
 
+# Code blocks without a language are shown as written (commands, logs, equations), not
+# coloured as Python; ".. code-block:: LAMMPS" and "```sh" choose their lexer.
+highlight_language = "none"
+
 html_theme = "sphinx_rtd_theme"
 html_title = "GRANULAR-CHARGED manual"
 html_show_sourcelink = False
 html_theme_options = {"navigation_depth": 3, "collapse_navigation": False}
+html_static_path = ["_static"]
+html_css_files = ["tables.css"]
 
 # Local links only: the build machine has no internet access, and the manual's
 # external references (papers, LAMMPS's own manual) are not ours to keep alive.
@@ -55,6 +61,7 @@ linkcheck_anchors = True
 # in the checkout, relative to the built HTML, so that they work when the manual is opened
 # from build/doc-html.  A path that does not exist is left alone and warns as before.
 import os
+import re
 
 _DOC_DIR = os.path.dirname(os.path.abspath(__file__))
 _REPO_DIR = os.path.dirname(_DOC_DIR)
@@ -144,7 +151,24 @@ def _lammps_lexer():
     return LAMMPSLexer
 
 
+# The Markdown pages write a mean or a placeholder in angle brackets, "<Z>", "<seed>": text to
+# the reader, but an HTML tag to Markdown, which a browser would hide.  Such tags become text
+# again; the pages' real HTML (anchors "<a id=...></a>") stays HTML.
+_PLACEHOLDER_TAG = re.compile(r"</?[A-Za-z_][^<>\s\"'=]*>")
+
+
+def _placeholders_as_text(app, doctree):
+    from docutils import nodes
+
+    for raw in list(doctree.findall(nodes.raw)):
+        text = raw.astext()
+        if ("html" in raw.get("format", "").split() and _PLACEHOLDER_TAG.fullmatch(text)
+                and text not in ("</a>", "<a>") and isinstance(raw.parent, nodes.TextElement)):
+            raw.parent.replace(raw, nodes.Text(text))
+
+
 def setup(app):
+    app.connect("doctree-read", _placeholders_as_text, priority=100)  # before the tocs are collected
     app.add_lexer("LAMMPS", _lammps_lexer())
     app.connect("missing-reference", _repository_path)
     app.connect("missing-reference", _lammps_page)
