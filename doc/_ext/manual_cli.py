@@ -17,20 +17,28 @@ def _escape(text):
     return _RST_SPECIAL.sub(r"\\\1", text) if text else text
 
 
-def _escape_parser(parser):
+def _escape_parser(parser, done):
+    # the common options are one set of action objects shared by every sub-command's parser
+    # (argparse's parents=): each object is escaped once
+    if id(parser) in done:
+        return
+    done.add(id(parser))
     parser.description = _escape(parser.description)
     parser.epilog = _escape(parser.epilog)
     for action in parser._actions:
-        if action.help not in (None, argparse.SUPPRESS):
+        if id(action) not in done and action.help not in (None, argparse.SUPPRESS):
+            done.add(id(action))
             action.help = _escape(action.help)
         if isinstance(action, argparse._SubParsersAction):
             for choice in action._choices_actions:
-                choice.help = _escape(choice.help)
-            for sub in set(action.choices.values()):
-                _escape_parser(sub)
+                if id(choice) not in done:
+                    done.add(id(choice))
+                    choice.help = _escape(choice.help)
+            for sub in action.choices.values():
+                _escape_parser(sub, done)
 
 
 def parser_for_manual():
     parser = build_parser()
-    _escape_parser(parser)
+    _escape_parser(parser, set())
     return parser
