@@ -2,7 +2,7 @@
 # Build the manual with warnings as errors and check its local links, and that every doc page
 # and every example is reachable from its index.  Exit status non-zero on any problem.
 #   scripts/check_manual.sh [HTML_DIR]      (default build/doc-html)
-# Needs Debian's python3-sphinx, python3-myst-parser, python3-sphinx-rtd-theme.
+# Needs Debian's python3-sphinx, python3-myst-parser, python3-sphinx-rtd-theme, python3-sphinx-argparse.
 set -uo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 out=${1:-$repo/build/doc-html}
