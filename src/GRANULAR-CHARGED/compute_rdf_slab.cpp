@@ -46,7 +46,7 @@ using MathConst::MY_PI;
 /* ---------------------------------------------------------------------- */
 
 ComputeRDFSlab::ComputeRDFSlab(LAMMPS *lmp, int narg, char **arg) :
-    Compute(lmp, narg, arg), buf(nullptr), bufall(nullptr), list(nullptr)
+    Compute(lmp, narg, arg), buf(nullptr), bufall(nullptr), list(nullptr), warned_outside(false)
 {
   if (narg < 5) utils::missing_cmd_args(FLERR, "compute rdf/slab", error);
   if (!atom->radius_flag)
@@ -207,6 +207,18 @@ void ComputeRDFSlab::compute_array()
     error->all(FLERR, Error::NOLASTLINE,
                "Compute rdf/slab slab [{}, {}] must lie inside the periodic z range [{}, {}]", lo,
                hi, domain->boxlo[2], domain->boxhi[2]);
+  // no centre lies outside a non-periodic z range, yet the slab's volume would count that
+  // empty part: the density would be too low and g(r) too high by (hi - lo) over the width of
+  // the part inside the box
+  if (!zper && !warned_outside && (lo < domain->boxlo[2] || hi > domain->boxhi[2])) {
+    warned_outside = true;
+    if (comm->me == 0)
+      error->warning(FLERR,
+                     "Compute rdf/slab {} slab [{}, {}] reaches outside the box's non-periodic z "
+                     "range [{}, {}]: g(r) counts the empty part as slab volume and is too high; "
+                     "choose zlo, zhi inside the box",
+                     id, lo, hi, domain->boxlo[2], domain->boxhi[2]);
+  }
   auto inslab = [&](double z) {
     return z >= lo && z <= hi;
   };

@@ -44,6 +44,7 @@ class ComputeRDFSlab : public Compute {
   double *buf,
       *bufall;    // local and global tallies: hist[nbin], count[nbin], capsum[nbin+1], nref
   class NeighList *list;    // occasional half list with cutoff rmax + skin
+  bool warned_outside;      // the slab outside a non-periodic z range has been reported
 
 };
 

@@ -43,7 +43,7 @@ FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), speed_sleep(-1.0), force_sleep(-1.0), force_wake(-1.0), rest_time(-1.0),
     depth(0.0), every(100), rest_steps_needed(0), rest_rule(true), asleep(nullptr), pushed(nullptr),
     rest_steps(nullptr), push(nullptr), wake_mark(nullptr), ncontact(nullptr), comm_mode(COMM_FLAGS),
-    set_generation(0), nsleeping_all(0), nsleep_events(0), nwake_events(0), pair_bookkeeping(false),
+    set_generation(0), nsleep_events(0), nwake_events(0), pair_bookkeeping(false),
     pair_history(nullptr)
 {
   if (!(atom->radius_flag && atom->rmass_flag && atom->omega_flag && atom->torque_flag))
@@ -203,7 +203,6 @@ void FixSleepGran::setup_pre_force(int /*vflag*/)
 
 void FixSleepGran::setup(int /*vflag*/)
 {
-  count_sleeping();
   hold_sleepers();
 }
 
@@ -258,7 +257,6 @@ void FixSleepGran::post_force(int /*vflag*/)
   if (nsleep_events != before) {
     exchange_flags();
     set_generation++;
-    count_sleeping();
   }
   hold_sleepers();
 }
@@ -377,7 +375,6 @@ void FixSleepGran::wake_pushed()
   nwake_events += all;
   exchange_flags();
   set_generation++;
-  count_sleeping();
 }
 
 /* ----------------------------------------------------------------------
@@ -498,21 +495,19 @@ void FixSleepGran::hold_sleepers()
   }
 }
 
-/* ---------------------------------------------------------------------- */
+/* ----------------------------------------------------------------------
+   the sleepers of all ranks, counted where they are asked for (compute_scalar, compute_vector:
+   called on every rank), so that the count is right whenever the flags changed: after
+   read_restart (the flags come with the atoms, before any run), delete_atoms, a wake
+------------------------------------------------------------------------- */
 
-void FixSleepGran::count_sleeping()
+bigint FixSleepGran::sleeping_count() const
 {
-  bigint n = 0;
+  bigint n = 0, all = 0;
   for (int i = 0; i < atom->nlocal; i++)
     if (asleep[i] != 0.0) n++;
-  MPI_Allreduce(&n, &nsleeping_all, 1, MPI_LMP_BIGINT, MPI_SUM, world);
-}
-
-/* ---------------------------------------------------------------------- */
-
-bigint FixSleepGran::awake_count() const
-{
-  return atom->natoms - nsleeping_all;
+  MPI_Allreduce(&n, &all, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+  return all;
 }
 
 /* ----------------------------------------------------------------------
@@ -521,7 +516,7 @@ bigint FixSleepGran::awake_count() const
 
 double FixSleepGran::compute_scalar()
 {
-  return static_cast<double>(awake_count());
+  return static_cast<double>(atom->natoms - sleeping_count());
 }
 
 /* ----------------------------------------------------------------------
@@ -531,8 +526,8 @@ double FixSleepGran::compute_scalar()
 
 double FixSleepGran::compute_vector(int n)
 {
-  if (n == 0) return static_cast<double>(awake_count());
-  if (n == 1) return static_cast<double>(nsleeping_all);
+  if (n == 0) return static_cast<double>(atom->natoms - sleeping_count());
+  if (n == 1) return static_cast<double>(sleeping_count());
   if (n == 2) return static_cast<double>(nsleep_events);
   return static_cast<double>(nwake_events);
 }

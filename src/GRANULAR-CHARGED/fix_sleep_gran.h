@@ -89,7 +89,7 @@ class FixSleepGran : public Fix {
   int comm_mode;         // what pack_forward_comm / pack_reverse_comm move
 
   bigint set_generation;
-  bigint nsleeping_all, nsleep_events, nwake_events;
+  bigint nsleep_events, nwake_events;
   bool pair_bookkeeping;    // the pair style sums push and contacts itself
   class FixNeighHistory *pair_history;    // the pair style's contact flags (null: none)
 
@@ -97,14 +97,13 @@ class FixSleepGran : public Fix {
   void sum_contacts_and_push();
   void mark_touching_sleepers();
   bool touching(int i, int j, int jj, const int *touch) const;
-  bigint awake_count() const;
+  bigint sleeping_count() const;
   bool at_rest(int i) const;
   void fall_asleep();
   void wake_pushed();
   void hold_sleepers();
   void surface_heights(std::vector<double> &top, int &nbx, int &nby) const;
   int column_of(const double *x, int nbx, int nby) const;
-  void count_sleeping();
   void check_fix_order();
 };
 

@@ -10,6 +10,7 @@
 #include "gran_sub_mod_normal_jkr_marshall.h"
 
 #include "citeme.h"
+#include "comm.h"
 #include "error.h"
 #include "gran_sub_mod.h"
 #include "granular_model.h"
@@ -116,6 +117,17 @@ void GranSubModNormalJKRMarshall::init()
                "Normal model jkr/marshall requires damping marshall (its second coefficient is "
                "the restitution coefficient that only damping marshall uses), got damping {}",
                gm->sub_models[DAMPING]->name);
+
+  // LAMMPS's own twisting marshall is accepted by jkr/marshall but is another model: its cap on
+  // the moment is (2/3) a F_crit, 13% above the Marshall-JKR 3 pi a F_crit / 16, its stiffness
+  // is per unit radius, and its history is negated on a neighbor rebuild. Said once per model
+  // as declared (pair_coeff, fix wall/gran, a restart): a model mixed from two declared ones
+  // was announced with them.
+  if (gm->sub_models[TWISTING]->name == "marshall" && !mixed_coefficients && comm->me == 0)
+    error->warning(FLERR,
+                   "Twisting marshall with normal jkr/marshall is LAMMPS's built-in twisting "
+                   "model, not the Marshall-JKR one (its cap on the moment is 13% higher): use "
+                   "twisting marshall/jkr");
 }
 
 /* ----------------------------------------------------------------------
