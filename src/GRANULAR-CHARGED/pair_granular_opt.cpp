@@ -67,9 +67,8 @@ struct HistoryPartners : FixNeighHistory {
   static int *FixNeighHistory::*count() { return &HistoryPartners::npartner; }
 };
 
-#if GC_LAMMPS_VERSION >= 20260704
 // the stored histories of pair styles granular and granular/opt no fix has taken
-std::vector<int> unclaimed_histories(Modify *modify)
+[[maybe_unused]] std::vector<int> unclaimed_histories(Modify *modify)
 {
   std::vector<int> found;
   char **ids = modify->*StoredFixData::ids();
@@ -81,7 +80,16 @@ std::vector<int> unclaimed_histories(Modify *modify)
       found.push_back(k);
   return found;
 }
-#endif
+
+// was fix `id` given its values by the restart file just read (even an empty history)?
+bool restored_from_restart(Modify *modify, const char *id)
+{
+  char **ids = modify->*StoredFixData::ids();
+  int *used = modify->*StoredFixData::used();
+  for (int k = 0; k < modify->nfix_restart_peratom; k++)
+    if (used[k] && strcmp(ids[k], id) == 0) return true;
+  return false;
+}
 
 bigint history_contacts(LAMMPS *lmp, FixNeighHistory *history)
 {
@@ -169,7 +177,7 @@ void PairGranularOpt::init_style()
   if (first_init) adopt_restart_history();
   PairGranular::init_style();
   if (first_init && fix_history) {
-    history_fresh = history_contacts(lmp, fix_history) == 0;
+    history_fresh = !restored_from_restart(modify, fix_history->id);
     history_fresh_checked = false;
   }
   fused_ready = false;    // init_one() may still mix new models: set up before the first compute
