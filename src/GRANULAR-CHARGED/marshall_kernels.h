@@ -186,39 +186,31 @@ namespace MarshallKernels {
     MathExtra::scale3(plensq > 0.0 ? sqrt(lensq / plensq) : 0.0, v);
   }
 
-  // Written with selects instead of branches (each select picks between values computed the
-  // same way as the branch would): the lanes of marshall_lanes.cpp vectorise it unchanged.
   inline void tangential_force(double *history, const double *nx, const double *vtr, double dt,
                                double k_scaled, double damp, double fscrit, bool history_update,
                                double *fs)
   {
     if (history_update) {
       const double rsht = MathExtra::dot3(history, nx);
-      const bool rotate = (fabs(rsht) * k_scaled) > (FRAME_EPSILON * fscrit);
-      double rotated[3];
-      MathExtra::copy3(history, rotated);
-      rotate_into_plane(rotated, nx, rsht);
+      if ((fabs(rsht) * k_scaled) > (FRAME_EPSILON * fscrit)) rotate_into_plane(history, nx, rsht);
       double increment[3];
       MathExtra::scale3(dt, vtr, increment);
-      for (int d = 0; d < 3; d++) history[d] = (rotate ? rotated[d] : history[d]) + increment[d];
+      MathExtra::add3(history, increment, history);
     }
     double fdamp[3];
     MathExtra::scale3(-k_scaled, history, fs);
     MathExtra::scale3(-damp, vtr, fdamp);
     MathExtra::add3(fs, fdamp, fs);
 
-    // slip: F_t scaled to the limit, h reset to the spring length of its elastic part (an
-    // empty spring gives no force)
     const double magfs_sq = MathExtra::lensq3(fs);
-    const bool slip = magfs_sq > fscrit * fscrit;
-    const bool stretched = MathExtra::lensq3(history) != 0.0;
-    const double ratio = fscrit / sqrt(magfs_sq);
-    const double inv_k = -1.0 / k_scaled;
-    for (int d = 0; d < 3; d++) {
-      const double fs_slip = fs[d] * ratio;
-      const double h_slip = (fs_slip - fdamp[d]) * inv_k;
-      history[d] = (slip && stretched) ? h_slip : history[d];
-      fs[d] = slip ? (stretched ? fs_slip : 0.0) : fs[d];
+    if (magfs_sq > fscrit * fscrit) {
+      if (MathExtra::lensq3(history) != 0.0) {
+        MathExtra::scale3(fscrit / sqrt(magfs_sq), fs);
+        MathExtra::sub3(fs, fdamp, history);
+        MathExtra::scale3(-1.0 / k_scaled, history);
+      } else {
+        MathExtra::zero3(fs);
+      }
     }
   }
 
@@ -233,20 +225,17 @@ namespace MarshallKernels {
   inline void rolling_force(double *history, const double *nx, const double *vrl, double dt,
                             double xi_crit, double k_over_reff, bool history_update, double *fr)
   {
-    double xi[3];
+    double xi[3], tmp[3];
     MathExtra::copy3(history, xi);
     if (history_update) {
       const double xin = MathExtra::dot3(xi, nx);
-      double rotated[3];
-      MathExtra::copy3(xi, rotated);
-      rotate_into_plane(rotated, nx, xin);
-      for (int d = 0; d < 3; d++) xi[d] = (xin != 0.0 ? rotated[d] : xi[d]) + dt * vrl[d];
+      if (xin != 0.0) rotate_into_plane(xi, nx, xin);
+      MathExtra::scale3(dt, vrl, tmp);
+      MathExtra::add3(xi, tmp, xi);
     }
     // irreversible rolling beyond theta_crit R
     const double lensq = MathExtra::lensq3(xi);
-    const double cap = xi_crit / sqrt(lensq);
-    const bool beyond = lensq > xi_crit * xi_crit;
-    for (int d = 0; d < 3; d++) xi[d] = beyond ? xi[d] * cap : xi[d];
+    if (lensq > xi_crit * xi_crit) MathExtra::scale3(xi_crit / sqrt(lensq), xi);
 
     MathExtra::scale3(-k_over_reff, xi, fr);
     if (history_update) MathExtra::copy3(xi, history);
@@ -270,99 +259,13 @@ namespace MarshallKernels {
     double angle = phi;
     if (history_update) angle += magtwist * dt;
 
-    const double trial = -k * angle - damp * magtwist;
-    const double moment = fabs(trial) > mcrit ? (trial > 0.0 ? mcrit : -mcrit) : trial;
-    const double angle_slip = (k > 0.0) ? -(moment + damp * magtwist) / k : 0.0;
-    angle = fabs(trial) > mcrit ? angle_slip : angle;
+    double moment = -k * angle - damp * magtwist;
+    if (fabs(moment) > mcrit) {
+      moment = (moment > 0.0) ? mcrit : -mcrit;
+      angle = (k > 0.0) ? -(moment + damp * magtwist) / k : 0.0;
+    }
     if (history_update) phi = angle;
     return moment;
-  }
-
-  /* ---------------------------------------------------------------------
-     one contact of the fused Marshall set (GranularModel::calculate_forces with these
-     sub-models, in its order of operations): the scalar kernel of pair_style granular/opt calls
-     it per contact, its SIMD lanes (marshall_lanes.h) per lane
-  --------------------------------------------------------------------- */
-
-  struct ContactInput {
-    double dx[3];           // x_i - x_j
-    double vr[3];           // v_i - v_j
-    double omegai[3], omegaj[3];
-    double radi, radj, reff;
-    double sqrt_mass;       // sqrt(mass_factor m*)
-  };
-  struct ContactCoeffs {
-    double alpha, k_t, mu, theta_crit, roll_radius_factor, dt;
-  };
-  struct ContactHistory {
-    double *tangential, *rolling, *twisting;    // 3, 3 and 1 values
-  };
-  struct ContactForces {
-    double forces[3], torquesi[3], torquesj[3];
-  };
-
-  // nf: the normal force of the contact's overlap (jkr_normal_force[_of_root])
-  inline void contact_forces(const ContactInput &in, const NormalForce &nf, const ContactCoeffs &c,
-                             bool rolling, bool twisting, bool history_update,
-                             const ContactHistory &h, ContactForces &out)
-  {
-    using namespace MathExtra;
-    const double r = sqrt(lensq3(in.dx));
-    const double rinv = 1.0 / r;
-    const double delta = in.radi + in.radj - r;
-    double nx[3], vn[3], vt[3], wr[3], temp[3], vtr[3];
-    scale3(rinv, in.dx, nx);
-    const double vnnr = dot3(in.vr, nx);
-    scale3(vnnr, nx, vn);
-    sub3(in.vr, vn, vt);
-    scaleadd3(in.radi, in.omegai, in.radj, in.omegaj, wr);
-    cross3(wr, nx, temp);
-    sub3(vt, temp, vtr);
-
-    const double damp_prefactor = damping_prefactor(c.alpha, in.sqrt_mass, nf);
-    const double fntot = nf.fne + (-damp_prefactor * vnnr);
-    const double fncrit = critical_force(nf);
-
-    // sliding
-    double fs[3];
-    tangential_force(h.tangential, nx, vtr, c.dt, c.k_t * nf.a, damp_prefactor, fncrit * c.mu,
-                     history_update, fs);
-
-    scale3(fntot, nx, out.forces);
-    add3(out.forces, fs, out.forces);
-    cross3(nx, fs, out.torquesi);
-    scale3(-1, out.torquesi);
-    copy3(out.torquesi, out.torquesj);
-    scale3(in.radi - 0.5 * delta, out.torquesi);
-    scale3(in.radj - 0.5 * delta, out.torquesj);
-
-    if (!rolling && !twisting) return;
-    double relrot[3];
-    sub3(in.omegai, in.omegaj, relrot);
-    if (rolling) {
-      // rolling velocity, eq. 31 of Wang et al, Particuology 23, 49 (2015)
-      const double reff = in.reff;
-      double vrl[3], fr[3], torroll[3];
-      vrl[0] = reff * (relrot[1] * nx[2] - relrot[2] * nx[1]);
-      vrl[1] = reff * (relrot[2] * nx[0] - relrot[0] * nx[2]);
-      vrl[2] = reff * (relrot[0] * nx[1] - relrot[1] * nx[0]);
-      rolling_force(h.rolling, nx, vrl, c.dt, c.theta_crit * (c.roll_radius_factor * reff),
-                    nf.adhesive / reff, history_update, fr);
-      cross3(nx, fr, torroll);
-      scale3(reff, torroll);
-      add3(out.torquesi, torroll, out.torquesi);
-      sub3(out.torquesj, torroll, out.torquesj);
-    }
-    if (twisting) {
-      // omega_T (eq. 29 of Marshall 2009)
-      const double magtwist = dot3(relrot, nx);
-      const double moment = twisting_moment(*h.twisting, magtwist, c.dt, nf.a, c.k_t,
-                                            damp_prefactor, c.mu * fncrit, history_update);
-      double tortwist[3];
-      scale3(moment, nx, tortwist);
-      add3(out.torquesi, tortwist, out.torquesi);
-      sub3(out.torquesj, tortwist, out.torquesj);
-    }
   }
 
 }    // namespace MarshallKernels

@@ -497,52 +497,80 @@ void PairGranularOpt::fused_contact(const Contact &c, int j, std::size_t &next_r
                                     PairForces &pf)
 {
   const int i = c.i;
-  const int model = types_indices[atom->type[i]][atom->type[j]];
-  const FusedMarshall &fm = fused[model];
-  MK::ContactInput in;
-  contact_input(c, j, fm, in);
-  copy3(in.dx, pf.dx);
+  const FusedMarshall &fm = fused[types_indices[atom->type[i]][atom->type[j]]];
+  double **x = atom->x, **v = atom->v, **omega = atom->omega;
+  const double radi = atom->radius[i], radj = atom->radius[j];
+  const double reff = c.scales.reff;
+  double *history = &fix_history->firstvalue[i][get_size_history() * c.jj];
+  const double dt = models_list[types_indices[atom->type[i]][atom->type[j]]]->dt;
+
+  double *dx = pf.dx;
+  sub3(x[i], x[j], dx);
+  const double rsq = lensq3(dx);
+  const double sqrt_mass = MK::damping_sqrt_mass(fm.mass_factor, effective_mass(i, j));
+
+  // kinematics (GranularModel::calculate_forces)
+  const double r = sqrt(rsq);
+  const double rinv = 1.0 / r;
+  const double delta = radi + radj - r;
+  double vr[3], nx[3], vn[3], vt[3], wr[3], temp[3], vtr[3];
+  sub3(v[i], v[j], vr);
+  scale3(rinv, dx, nx);
+  const double vnnr = dot3(vr, nx);
+  scale3(vnnr, nx, vn);
+  sub3(vr, vn, vt);
+  scaleadd3(radi, omega[i], radj, omega[j], wr);
+  cross3(wr, nx, temp);
+  sub3(vt, temp, vtr);
+
   // normal: JKR with Marshall damping (the root from the batch)
-  const double delta = in.radi + in.radj - sqrt(lensq3(in.dx));
   const MK::NormalForce nf = (fm.gamma != 0.0)
       ? MK::jkr_normal_force_of_root(c.scales.scales, jkr_root[next_root++])
-      : MK::jkr_normal_force(c.scales.scales, fm.gamma, fm.emix, delta, c.scales.reff);
-  MK::ContactForces out;
-  MK::contact_forces(in, nf, contact_coeffs(fm, models_list[model]->dt), fm.rolling, fm.twisting,
-                     history_update, contact_history(c), out);
-  copy3(out.forces, pf.forces);
-  copy3(out.torquesi, pf.torquesi);
-  copy3(out.torquesj, pf.torquesj);
-}
+      : MK::jkr_normal_force(c.scales.scales, fm.gamma, fm.emix, delta, reff);
+  const double damp_prefactor = MK::damping_prefactor(fm.alpha, sqrt_mass, nf);
+  const double fntot = nf.fne + (-damp_prefactor * vnnr);
+  const double fncrit = MK::critical_force(nf);
 
-/* ----------------------------------------------------------------------
-   the inputs, coefficients and history of one fused contact
-------------------------------------------------------------------------- */
+  // sliding
+  double fs[3];
+  MK::tangential_force(&history[hist_tangential], nx, vtr, dt, fm.k_t * nf.a, damp_prefactor,
+                       fncrit * fm.mu, history_update, fs);
 
-void PairGranularOpt::contact_input(const Contact &c, int j, const FusedMarshall &fm,
-                                    MK::ContactInput &in) const
-{
-  const int i = c.i;
-  double **x = atom->x, **v = atom->v, **omega = atom->omega;
-  sub3(x[i], x[j], in.dx);
-  sub3(v[i], v[j], in.vr);
-  copy3(omega[i], in.omegai);
-  copy3(omega[j], in.omegaj);
-  in.radi = atom->radius[i];
-  in.radj = atom->radius[j];
-  in.reff = c.scales.reff;
-  in.sqrt_mass = MK::damping_sqrt_mass(fm.mass_factor, effective_mass(i, j));
-}
+  scale3(fntot, nx, pf.forces);
+  add3(pf.forces, fs, pf.forces);
+  cross3(nx, fs, pf.torquesi);
+  scale3(-1, pf.torquesi);
+  copy3(pf.torquesi, pf.torquesj);
+  scale3(radi - 0.5 * delta, pf.torquesi);
+  scale3(radj - 0.5 * delta, pf.torquesj);
 
-MK::ContactCoeffs PairGranularOpt::contact_coeffs(const FusedMarshall &fm, double dt)
-{
-  return {fm.alpha, fm.k_t, fm.mu, fm.theta_crit, fm.roll_radius_factor, dt};
-}
-
-MK::ContactHistory PairGranularOpt::contact_history(const Contact &c) const
-{
-  double *history = &fix_history->firstvalue[c.i][get_size_history() * c.jj];
-  return {history + hist_tangential, history + hist_rolling, history + hist_twisting};
+  if (!fm.rolling && !fm.twisting) return;
+  double relrot[3];
+  sub3(omega[i], omega[j], relrot);
+  if (fm.rolling) {
+    // rolling velocity, eq. 31 of Wang et al, Particuology 23, 49 (2015)
+    double vrl[3], fr[3], torroll[3];
+    vrl[0] = reff * (relrot[1] * nx[2] - relrot[2] * nx[1]);
+    vrl[1] = reff * (relrot[2] * nx[0] - relrot[0] * nx[2]);
+    vrl[2] = reff * (relrot[0] * nx[1] - relrot[1] * nx[0]);
+    MK::rolling_force(&history[hist_rolling], nx, vrl, dt,
+                      fm.theta_crit * (fm.roll_radius_factor * reff), nf.adhesive / reff,
+                      history_update, fr);
+    cross3(nx, fr, torroll);
+    scale3(reff, torroll);
+    add3(pf.torquesi, torroll, pf.torquesi);
+    sub3(pf.torquesj, torroll, pf.torquesj);
+  }
+  if (fm.twisting) {
+    // omega_T (eq. 29 of Marshall 2009)
+    const double magtwist = dot3(relrot, nx);
+    const double moment = MK::twisting_moment(history[hist_twisting], magtwist, dt, nf.a, fm.k_t,
+                                              damp_prefactor, fm.mu * fncrit, history_update);
+    double tortwist[3];
+    scale3(moment, nx, tortwist);
+    add3(pf.torquesi, tortwist, pf.torquesi);
+    sub3(pf.torquesj, tortwist, pf.torquesj);
+  }
 }
 
 /* ----------------------------------------------------------------------

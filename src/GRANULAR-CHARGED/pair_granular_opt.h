@@ -117,10 +117,6 @@ class PairGranularOpt : public PairGranular {
   void compute_fused_contacts();
   void fused_contact(const Contact &c, int j, std::size_t &next_root, PairForces &pf);
   void scatter(int i, int j, double factor_lj, PairForces &pf);
-  void contact_input(const Contact &c, int j, const FusedMarshall &fm,
-                     MarshallKernels::ContactInput &in) const;
-  static MarshallKernels::ContactCoeffs contact_coeffs(const FusedMarshall &fm, double dt);
-  MarshallKernels::ContactHistory contact_history(const Contact &c) const;
   PairScales scales_of(int i, int j, const FusedMarshall &fm) const;
   double effective_mass(int i, int j) const;
 };
