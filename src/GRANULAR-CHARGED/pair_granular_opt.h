@@ -103,6 +103,11 @@ class PairGranularOpt : public PairGranular {
   std::vector<double *> generic_firsthistory;
 
   void setup_fused();
+  // the contact history across a switch of style: see the .cpp
+  bool history_fresh;                    // its fix was created empty by this style's first init
+  bool history_fresh_checked;            // the touching pairs of a fresh history were counted
+  void adopt_restart_history();
+  void warn_fresh_history();
   void update_active(const double *asleep, bigint generation);
   // the steps of compute()
   void begin_step(int eflag, int vflag);
