@@ -17,3 +17,6 @@ gc_lammps_test(test_sleep_gran NP 1 2 SOURCES test_sleep_gran.cpp)
 # keywords efield, polarize, electrode (gcfmm::PolarizableSolver through the fix)
 gc_lammps_test(test_coul_fmm_polarize NP 1 2 SOURCES test_coul_fmm_polarize.cpp)
 gc_lammps_test(test_wall_gran_opt NP 1 2 SOURCES test_wall_gran_opt.cpp)
+# fix coul/fmm refuses non-finite charges and unreachable accuracies (one rank: a bad charge
+# stops the rank that owns it)
+gc_lammps_test(test_coul_fmm_input_checks SOURCES test_coul_fmm_input_checks.cpp)
