@@ -94,6 +94,7 @@ double CoulFMMChargeScheme::compute(bool predict)
 void CoulFMMChargeScheme::compute_field(bool with_slope)
 {
   CoulFMMState &st = *p.state;
+  st.check_charges(p.fix->id);
   CoulFMMTimeStepping &mts = *p.stepping;
   const int nlocal = atom->nlocal;
   eval->update_sleepers();

@@ -295,6 +295,7 @@ bool CoulFMMPolarizable::advance(double **field, double **force_out, double &ene
 
 double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool predict, int stride)
 {
+  parts.state->check_charges(parts.fix->id);
   gather();
   map_local();
   const std::vector<tagint> &gtag = gathered.tag;

@@ -11,6 +11,7 @@
 
 #include "atom.h"
 #include "domain.h"
+#include "error.h"
 #include "force.h"
 #include "update.h"
 
@@ -102,6 +103,17 @@ void CoulFMMState::remember_positions()
 {
   for (int i = 0; i < atom->nlocal; i++)
     domain->unmap(atom->x[i], atom->image[i], &row[i][MTS::LAST_X]);
+}
+
+// one pass over the local charges; error->one, as the atom is on this rank only
+void CoulFMMState::check_charges(const char *fix_id) const
+{
+  const double *q = atom->q;
+  const int *mask = atom->mask;
+  for (int i = 0; i < atom->nlocal; i++)
+    if ((mask[i] & groupbit) && !std::isfinite(q[i]))
+      error->one(FLERR, "Fix coul/fmm {}: atom {} has charge {}: charges must be finite", fix_id,
+                 atom->tag[i], q[i]);
 }
 
 /* ----------------------------------------------------------------------

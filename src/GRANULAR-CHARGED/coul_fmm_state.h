@@ -61,6 +61,9 @@ class CoulFMMState : protected Pointers {
   void apply_evaluated(int i);
   // where the local atoms are now: a later run continues the stored field only from there
   void remember_positions();
+  // before an evaluation: every charge of the group is finite, else an error naming the atom
+  // (a NaN or inf charge would make every field and force NaN)
+  void check_charges(const char *fix_id) const;
 
   // ---- the continuity record: what the stored evaluation belongs to ----
   // asleep_now(i): atom i is a static source now (fix sleep/gran with static sleepers)

@@ -26,7 +26,9 @@
 #include "update.h"
 
 #include "gcfmm/options.hpp"
+#include "gcfmm/polarizable_solver.hpp"
 
+#include <cmath>
 #include <exception>
 #include <map>
 #include <vector>
@@ -221,6 +223,7 @@ void FixCoulFMM::init()
 void FixCoulFMM::check_boundary_and_options()
 {
   backend->set_geometry(*opts, bed_given);
+  check_accuracy_reachable();
   const bool periodic = opts->boundary == gcfmm::Boundary::Periodic2D, me0 = comm->me == 0;
   if (!periodic && !periodic_keyword.empty() && me0)
     error->warning(FLERR,
@@ -242,6 +245,30 @@ void FixCoulFMM::check_boundary_and_options()
                    "Fix coul/fmm {} with boundary p p f contributes only the zz component of "
                    "the virial (the in-plane components of sum x_i F_i are not the lattice virial)",
                    id);
+}
+
+// a requested accuracy is delivered or refused: beyond order 30 (or the exact periodic far
+// field's finest parameter set) the solver would serve a finer request with a larger error
+void FixCoulFMM::check_accuracy_reachable()
+{
+  const bool dipoles = field_cols == 7;
+  // the induced dipoles' expansions are tightened by this factor (gcfmm::PolarizableSolver)
+  const double margin = dipoles ? gcfmm::PolarizableSolver::dipole_accuracy_margin(opts->accuracy) : 1.0;
+  const double finest = margin * gcfmm::finest_accuracy(*opts);
+  if (opts->accuracy >= finest) return;
+  const bool exact_far = opts->boundary == gcfmm::Boundary::Periodic2D &&
+      opts->farfield == gcfmm::FarField::Exact;
+  std::string why = fmt::format("order {} at theta {:g}", gcfmm::kMaxOrder, gcfmm::resolve(*opts).theta);
+  if (exact_far && finest == margin * gcfmm::kFinestFarFieldAccuracy)
+    why = fmt::format("the exact periodic far field is calibrated down to {:g}",
+                      gcfmm::kFinestFarFieldAccuracy);
+  if (dipoles) why += fmt::format(", times {:g} for the induced dipoles", margin);
+  // two digits, rounded up: the suggested request is reachable
+  const double digit = std::pow(10.0, std::floor(std::log10(finest)) - 1.0);
+  error->all(FLERR,
+             "Fix coul/fmm {} accuracy {:g} is finer than the solver reaches with these "
+             "settings: {:.3g} ({}); request accuracy {:.2g} or larger",
+             id, opts->accuracy, finest, why, std::ceil(finest / digit) * digit);
 }
 
 void FixCoulFMM::init_list(int /*id*/, NeighList *ptr)

@@ -86,6 +86,7 @@ class FixCoulFMM : public Fix {
   CoulFMMScheme::Parts parts();
   int one_of(int iarg, const std::vector<std::string> &words, char **arg);
   void check_boundary_and_options();
+  void check_accuracy_reachable();
   void apply(int vflag, bool predict);
 };
 

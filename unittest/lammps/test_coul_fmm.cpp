@@ -741,10 +741,10 @@ TEST(CoulFMM, NearRefreshAndCheck)
   auto measured = [](const std::string &near) {
     Lmp l;
     moving_charges(l, "m m m");
-    l.cmds({"fix fmm all coul/fmm accuracy 1e-10 every 1000 check 5 " + near, "run 15 post no"});
+    l.cmds({"fix fmm all coul/fmm accuracy 1e-10 order 30 every 1000 check 5 " + near, "run 15 post no"});
     const auto f = gather(l, "f", 3);
     std::vector<double> m = {l.var("f_fmm[5]"), l.var("f_fmm[6]"), l.var("f_fmm[7]")};
-    l.cmds({"unfix fmm", "fix fresh all coul/fmm accuracy 1e-10", "run 0 post no"});
+    l.cmds({"unfix fmm", "fix fresh all coul/fmm accuracy 1e-10 order 30", "run 0 post no"});
     m.push_back(rel_rms(f, gather(l, "f", 3)));    // the error at step 15, by hand
     return m;
   };
@@ -771,7 +771,7 @@ TEST(CoulFMM, ExtrapolationFollowsSmoothMotion)
     Lmp l;
     moving_charges(l, "p p m");
     l.cmds({"mass 1 100000.0",
-            "fix fmm all coul/fmm accuracy 1e-10 every 10 near 5.0 check 59 extrapolate " +
+            "fix fmm all coul/fmm accuracy 1e-10 order 30 every 10 near 5.0 check 59 extrapolate " +
                 extrapolate,
             "run 59 post no"});
     return l.var("f_fmm[5]");
@@ -796,7 +796,7 @@ TEST(CoulFMM, ToleranceAdaptsTheInterval)
     // heavy: no pair of opposite charges collapses within the run (the atom IDs, hence the
     // charges, depend on the number of ranks)
     l.cmds({"mass 1 100000.0",
-            "fix fmm all coul/fmm accuracy 1e-10 every 64 near 5.0 check 3 tolerance " +
+            "fix fmm all coul/fmm accuracy 1e-10 order 30 every 64 near 5.0 check 3 tolerance " +
                 tolerance,
             "run 120 post no"});
     return std::vector<double>{l.var("f_fmm[7]"), l.var("f_fmm[8]"), l.var("f_fmm[9]"),
@@ -861,7 +861,7 @@ TEST(CoulFMM, AverageFarFieldEnergyMatchesForces)
   Lmp l;
   random_charges(l, "p p f", 100, 20.0, 40.0, 71);
   l.cmds({"set group all charge 1.0", "group one id 7",
-          "fix fmm all coul/fmm accuracy 1e-10 farfield average bed 0 40",
+          "fix fmm all coul/fmm accuracy 1e-10 order 30 farfield average bed 0 40",
           "fix_modify fmm energy yes", "run 0 post no"});
   const double fx = l.var("fx[7]"), fz = l.var("fz[7]");
   const double h = 1e-4;    // A: central-difference error ~h^2 |F'''|, far below 1e-6 |F|

@@ -91,7 +91,7 @@ TEST(CoulFMMDistributed, MatchesReferenceAtEachRankCount)
                        Case{"p p f", "none"}}) {
     const std::string ff = std::string(" farfield ") + c.farfield;
     const Result ref = run_fix(c.boundary, "processors * * *",
-                               "fix fmm all coul/fmm accuracy 1e-9 solver replicated" + ff);
+                               "fix fmm all coul/fmm accuracy 1e-9 order 27 solver replicated" + ff);
     for (const char *grid : {"processors * * 1", "processors 1 1 *"}) {
       for (double acc : {1e-4, 1e-6}) {
         const std::string opts = fmt::format("accuracy {}{}", acc, ff);

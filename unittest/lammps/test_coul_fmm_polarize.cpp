@@ -111,7 +111,7 @@ TEST(CoulFMMPolarize, TwoSpheresInAField)
     for (const bool along : {true, false}) {
       Lmp l;
       spheres(l, "f f f", {{5.0, 5.0, 5.0, 0.0}, {along ? 5.0 : 5.0 + d, 5.0, along ? 5.0 + d : 5.0, 0.0}});
-      l.cmds({"fix fmm all coul/fmm accuracy 1e-8 polarize 4.0 efield 0 0 0.5", "run 0 post no"});
+      l.cmds({"fix fmm all coul/fmm accuracy 1e-8 order 28 polarize 4.0 efield 0 0 0.5", "run 0 post no"});
       const auto f = gather(l, "f", 3);
       const double eb = kQe2f * E / kQqr2e;
       const double p = along ? alpha * eb / (1 - 2 * alpha / std::pow(d, 3)) : alpha * eb / (1 + alpha / std::pow(d, 3));
@@ -137,13 +137,13 @@ TEST(CoulFMMPolarize, ForceIsMinusEnergyGradient)
     moved[atom][dim] += dx;
     Lmp l;
     spheres(l, "p p f", moved, 9.0);
-    l.cmds({"fix fmm all coul/fmm accuracy 1e-10 polarize 3.8 efield 0 0 0.4 electrode 0.5",
+    l.cmds({"fix fmm all coul/fmm accuracy 1e-10 order 30 polarize 3.8 efield 0 0 0.4 electrode 0.5",
             "fix_modify fmm energy yes", "run 0 post no"});
     return l.var("f_fmm");
   };
   Lmp l;
   spheres(l, "p p f", atoms, 9.0);
-  l.cmds({"fix fmm all coul/fmm accuracy 1e-10 polarize 3.8 efield 0 0 0.4 electrode 0.5",
+  l.cmds({"fix fmm all coul/fmm accuracy 1e-10 order 30 polarize 3.8 efield 0 0 0.4 electrode 0.5",
           "fix_modify fmm energy yes", "run 0 post no"});
   const auto f = gather(l, "f", 3);
   const double h = 1e-4;
@@ -162,7 +162,7 @@ TEST(CoulFMMPolarize, ForceIsMinusEnergyGradient)
 TEST(CoulFMMPolarize, RestartContinuesTheRun)
 {
   const auto atoms = random_spheres(27, 5, 9.0);
-  const std::string fix = "fix fmm all coul/fmm accuracy 1e-8 polarize 3.8 efield 0 0 0.4 electrode 0.5";
+  const std::string fix = "fix fmm all coul/fmm accuracy 1e-8 order 28 polarize 3.8 efield 0 0 0.4 electrode 0.5";
   auto setup = [&](Lmp &l) {
     spheres(l, "p p f", atoms, 9.0);
     l.cmds({fix, "fix_modify fmm energy yes", "fix nve all nve/sphere", "timestep 0.1"});
@@ -358,7 +358,7 @@ Moved moving(const std::string &bc, const std::string &fix, int steps, MPI_Comm 
 // accuracy, energy included; the evaluation's force held (no near refresh) does not
 TEST(CoulFMMPolarize, TimeSteppingWithEveryPairNearIsExact)
 {
-  const std::string base = "fix fmm all coul/fmm accuracy 1e-10 efield 0 0 -0.3 electrode 0.5";
+  const std::string base = "fix fmm all coul/fmm accuracy 1e-10 order 30 efield 0 0 -0.3 electrode 0.5";
   const Moved every = moving("f f f", base, 28);
   const Moved near = moving("f f f", base + " every 8 near 100 extrapolate no", 28);
   const Moved held = moving("f f f", base + " every 8 extrapolate no", 28);
@@ -446,7 +446,7 @@ TEST(CoulFMMPolarize, MinimizeUsesTheCurrentPositions)
   for (auto &a : atoms) a[3] = 0.3;
   Lmp l;
   spheres(l, "p p f", atoms, 6.0);
-  l.cmds({"fix fmm all coul/fmm accuracy 1e-8 polarize 3.8 efield 0 0 -0.5 electrode 0.5",
+  l.cmds({"fix fmm all coul/fmm accuracy 1e-8 order 28 polarize 3.8 efield 0 0 -0.5 electrode 0.5",
           "fix_modify fmm energy yes virial yes", "thermo_style custom step pe press", "run 0 post no"});
   const double e0 = l.var("pe");
   // small steps: with pair_style zero nothing keeps the attracting spheres apart

@@ -275,7 +275,7 @@ void charged_spheres(Lmp &l, const std::string &coul)
 TEST(FixSleepGran, CoulombSleepersAreAStaticSource)
 {
   Lmp ref;
-  charged_spheres(ref, "fix coul all coul/fmm accuracy 1e-9 sleepers full");
+  charged_spheres(ref, "fix coul all coul/fmm accuracy 1e-9 order 27 sleepers full");
   const double nsleep = ref.var("f_sleep[2]");
   EXPECT_EQ(nsleep, 144.0);
   const auto fref = gather(ref, "f", 3);

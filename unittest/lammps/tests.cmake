@@ -24,3 +24,6 @@ gc_lammps_test(test_silent_mistakes NP 1 2 SOURCES test_silent_mistakes.cpp)
 gc_lammps_test(test_granular_opt_switch SOURCES test_granular_opt_switch.cpp)
 target_compile_definitions(test_granular_opt_switch PRIVATE GC_LMP_EXECUTABLE="$<TARGET_FILE:lmp>")
 add_dependencies(test_granular_opt_switch lmp)
+# fix coul/fmm refuses non-finite charges and unreachable accuracies (one rank: a bad charge
+# stops the rank that owns it)
+gc_lammps_test(test_coul_fmm_input_checks SOURCES test_coul_fmm_input_checks.cpp)

@@ -17,6 +17,7 @@
 #include <string>
 
 #include "gcfmm/lattice_sum.hpp"
+#include "gcfmm/options.hpp"
 #include "gcfmm/types.hpp"
 
 namespace gcfmm {
@@ -42,7 +43,7 @@ constexpr ParamSet kParams[] = {
     {1e-5, 10, 8, 1.0, 2.6e-6},
     {1e-6, 12, 10, 1.0, 7.8e-8},
     {1e-7, 14, 12, 1.0, 4.3e-9},
-    {0.0, 14, 12, 0.7, 4.3e-9},    // down to 1e-8
+    {0.0, 14, 12, 0.7, 4.3e-9},    // down to kFinestFarFieldAccuracy
 };
 
 const ParamSet &params_for(double accuracy) {
@@ -54,9 +55,12 @@ const ParamSet &params_for(double accuracy) {
 }  // namespace
 
 void PeriodicFarField::parameters_for(double accuracy, int *pxy, int *pz, double *hz_over_l) {
-  if (!(accuracy >= 1e-8) || !(accuracy < 1.0))
-    throw std::invalid_argument("gcfmm::PeriodicFarField: accuracy must be in [1e-8, 1), got " +
-                                std::to_string(accuracy));
+  if (!(accuracy >= kFinestFarFieldAccuracy) || !(accuracy < 1.0)) {
+    char what[96];
+    std::snprintf(what, sizeof what, "gcfmm::PeriodicFarField: accuracy must be in [%g, 1), got %g",
+                  kFinestFarFieldAccuracy, accuracy);
+    throw std::invalid_argument(what);
+  }
   const ParamSet &ps = params_for(accuracy);
   *pxy = ps.pxy;
   *pz = ps.pz;

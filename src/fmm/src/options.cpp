@@ -1,6 +1,7 @@
 // GRANULAR-CHARGED FMM core library (gcfmm): option validation and error-control rule.
 #include "gcfmm/options.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -73,6 +74,15 @@ Resolved resolve(const Options &o) {
   }
   r.estimated_error = predicted_error(r.order, r.theta);
   return r;
+}
+
+double finest_accuracy(const Options &o) {
+  if (o.order > 0) return 0.0;
+  Options finest = o;
+  finest.accuracy = 0.0;    // resolve() then takes kMaxOrder
+  const double near = resolve(finest).estimated_error;
+  const bool exact_far = o.boundary == Boundary::Periodic2D && o.farfield == FarField::Exact;
+  return exact_far ? std::max(near, kFinestFarFieldAccuracy) : near;
 }
 
 }  // namespace gcfmm

@@ -16,6 +16,9 @@ enum class FarField { None, Average, Exact };
 inline constexpr int kMaxOrder = 30;
 // lowest order the automatic choice takes (p = 1 leaves too few terms for the error model)
 inline constexpr int kMinAutoOrder = 2;
+//! Finest accuracy the exact periodic far field is calibrated for (its last parameter set,
+//! doc/fmm-far-field.md); finer requests get this set.
+inline constexpr double kFinestFarFieldAccuracy = 1e-8;
 
 //! Solver options. Zero means "choose from accuracy" for order, theta and leaf.
 struct Options {
@@ -45,6 +48,12 @@ struct Resolved {
  *  @param opts validated options
  *  @return order, theta and leaf (explicit user values are kept) and the predicted error */
 Resolved resolve(const Options &opts);
+
+/** @brief The finest accuracy these options deliver: with the order chosen from accuracy
+ *  (order 0), the model's error at kMaxOrder and the resolved theta, and with Periodic2D and
+ *  FarField::Exact at least kFinestFarFieldAccuracy; with an explicit order 0 (accuracy does
+ *  not choose the order then). A finer request would be served with a larger error. */
+double finest_accuracy(const Options &opts);
 
 /** @brief Predicted relative RMS force error of the calibrated model for (order, theta). */
 double predicted_error(int order, double theta);
