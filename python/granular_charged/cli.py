@@ -96,6 +96,29 @@ def _deck_options(p: argparse.ArgumentParser, many: bool):
     p.add_argument("--no-render", action="store_true", help="no rendered packing image")
 
 
+def engine_options(p: argparse.ArgumentParser):
+    """How a study's runs run: locally, or submitted to Slurm or another batch system (the
+    workflow engine, Snakemake: doc/python.md, "Many runs and clusters")."""
+    g = p.add_argument_group("where the runs run (Snakemake)")
+    g.add_argument("--jobs", "--cores", type=_count, default=1,
+                   help="runs at a time on this machine; with --slurm or --cluster: jobs "
+                        "queued at once")
+    g.add_argument("--slurm", action="store_true",
+                   help="submit each run as a Slurm job (sbatch) with its --np MPI ranks and a "
+                        "time limit from its estimated cost")
+    g.add_argument("--account", default=None, help="Slurm account (sbatch -A)")
+    g.add_argument("--partition", default=None, help="Slurm partition (sbatch -p)")
+    g.add_argument("--mem-mb", type=_count, default=None, metavar="MB",
+                   help="memory per job [MB] on a cluster")
+    g.add_argument("--cluster", default=None, metavar="TEMPLATE",
+                   help="submit each run with this command (Snakemake's --cluster template, e.g. "
+                        "'qsub -l walltime={resources.runtime}:00 -pe mpi {resources.tasks}')")
+    g.add_argument("--dry-run", action="store_true",
+                   help="print the runs that would run or be submitted, run nothing")
+    g.add_argument("--unlock", action="store_true",
+                   help="first remove the lock a killed study left on the folder")
+
+
 def build_parser() -> argparse.ArgumentParser:
     common = _common()
     ap = argparse.ArgumentParser(
@@ -125,7 +148,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--preset", choices=["paper"], help="the paper's full set of cases")
     p.add_argument("--seeds", type=_count, nargs="+", default=[4711],
                    help="seeds of the injection positions (default 4711)")
-    p.add_argument("--jobs", type=_count, default=1, help="runs at a time")
+    engine_options(p)
     p.add_argument("--figures", default=None, metavar="DIR", help="then draw the figures here")
     _deck_options(p, many=True)
 
@@ -134,7 +157,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "protocol, grid, seeds; doc/populations.md), resumably, then its "
                                    "tables and figures (labelled with its name) in its out folder.")
     p.add_argument("file", help="the study file (TOML)")
-    p.add_argument("--jobs", type=_count, default=1, help="runs at a time")
+    engine_options(p)
     p.add_argument("--np", type=_count, default=1, help="MPI ranks per run")
     p.add_argument("--no-render", action="store_true", help="no rendered packing images")
     p.add_argument("--estimate-only", action="store_true",
@@ -166,7 +189,6 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
                    help="a variable of in.charged-after-formation for every run (the formed "
                         "run's own settings are taken over), e.g. --var relax_rp 50")
-    p.add_argument("--jobs", type=_count, default=1, help="runs at a time")
     p.add_argument("--np", type=_count, default=1, help="MPI ranks per run")
 
     p = sub.add_parser("reproduce", parents=[common],
@@ -253,7 +275,7 @@ def _study_options(p: argparse.ArgumentParser, name: str, var_help: str,
                    help="seeds of the injection positions (default 1 2 3)")
     p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
                    help=var_help)
-    p.add_argument("--jobs", type=_count, default=1, help="runs at a time")
+    engine_options(p)
     p.add_argument("--np", type=_count, default=1, help="MPI ranks per run")
     p.add_argument("--no-render", action="store_true", help="no rendered packing images")
     if finished_only:
@@ -350,6 +372,11 @@ def _runner(a, render=True):
                   checkpoint=getattr(a, "checkpoint", 0))
 
 
+def _engine(a):
+    from .engine import Engine
+    return Engine.from_args(a)
+
+
 def cmd_run(a) -> int:
     from .runner import RunError, Runner
     from .sweep import fmt
@@ -368,7 +395,7 @@ def cmd_run(a) -> int:
     runner.show_progress = a.progress
     log.info("run %s in %s (LAMMPS build %s)", p.key(), out.resolve(), runner.build.path)
     try:
-        r = runner.deposition(p, out, force=a.force, tracer=a.tracer)
+        r = runner.deposition(p, out, force=a.force, tracer=a.tracer, lock=True)
     except RunError as e:
         log.error("%s", e)
         return 1
@@ -399,8 +426,7 @@ def cmd_sweep(a) -> int:
             log.warning("%d charged runs NOT run: fix coul/fmm is absent from %s", len(skip),
                         runner.build.path)
         params = [p for p in params if not is_charged(p.deck_vars())]
-    runner.show_progress = a.progress and a.jobs == 1
-    res = Sweep(runner, out, jobs=a.jobs, progress=a.progress).run(params, a.tracer)
+    res = Sweep(runner, out, engine=_engine(a)).run(params, a.tracer)
     if figs is not None and params:
         from .tables import variant
         _figures(load_results(out), figs, None, variant(vars(params[0])))
@@ -433,7 +459,7 @@ def cmd_study(a) -> int:
         d = studyfile.load(a.file)
         announce(studyfile.params(d), Path(d["out"]) / "runs", d["protocol"])
         return 0
-    res = studyfile.run(a.file, _runner(a, not a.no_render), jobs=a.jobs, progress=a.progress)
+    res = studyfile.run(a.file, _runner(a, not a.no_render), engine=_engine(a))
     print(res["summary"].to_string(index=False))
     for f in res["figures"]:
         print(f)
@@ -458,7 +484,7 @@ def cmd_table2(a) -> int:
     from .params import split_deck_vars
     _, extra = split_deck_vars(a.var, deck_variables(DECK), OWN, DECK)
     out = _out_dir(a.out)
-    rows = run_table2(_runner(a), Path(a.formed), a.q, out, extra, jobs=a.jobs)
+    rows = run_table2(_runner(a), Path(a.formed), a.q, out, extra)
     print(tables.format_table(tables.table2_frame(rows), "{:.5g}"))
     return 0
 
@@ -469,7 +495,7 @@ def cmd_reproduce(a) -> int:
     fields, extra = _vars(a, "reproduce")
     study = Reproduction(out=_out_dir(a.out), size_name=a.size, seeds=tuple(a.seeds),
                          extra=extra, fields=fields, jobs=a.jobs, progress=a.progress,
-                         finished_only=a.finished_only)
+                         finished_only=a.finished_only, engine=_engine(a))
     for p in study.params(True):
         Runner.check(p, study.tracer(p))
     res = study.run(_runner(a, not a.no_render))
@@ -485,7 +511,7 @@ def cmd_demo(a) -> int:
     fields, extra = _vars(a, "demo")
     study = Demo(out=_out_dir(a.out), N=a.N, qs=tuple(a.q), seeds=tuple(a.seeds),
                  table2_qs=tuple(a.table2_q), extra={**DEMO_VARS, **extra}, fields=fields,
-                 jobs=a.jobs, progress=a.progress, follow=a.tracer)
+                 jobs=a.jobs, progress=a.progress, follow=a.tracer, engine=_engine(a))
     for p in study.params(True):
         Runner.check(p, study.tracer(p))
     res = study.run(_runner(a, not a.no_render))
@@ -503,7 +529,7 @@ def _study_runs(a, params) -> tuple[Path, list[dict]]:
     out = _out_dir(a.out)
     runs = out / "runs"
     if not a.finished_only:
-        Sweep(_runner(a, not a.no_render), runs, jobs=a.jobs, progress=a.progress).run(params)
+        Sweep(_runner(a, not a.no_render), runs, engine=_engine(a)).run(params)
     keys = {p.key() for p in params}
     results = [r for r in load_results(runs) if r["key"] in keys] if runs.exists() else []
     if not results:
@@ -592,11 +618,17 @@ def main(argv=None) -> int:
     verbose, quiet = getattr(a, "verbose", 0), getattr(a, "quiet", 0)
     setup_logging(verbose, quiet)
     a.progress = quiet == 0 and sys.stderr.isatty()
+    from .engine import DryRunDone, EngineError
     from .lammps_build import BuildError
     from .params import ParamError
     from .runner import RunError
     try:
         return COMMANDS[a.command](a)
+    except DryRunDone:
+        return 0
+    except EngineError as e:
+        log.error("granular-charged %s: %s", a.command, e)
+        return 1
     except ParamError as e:
         # before any run: nothing was started or written
         log.error("granular-charged %s: %s", a.command, e)

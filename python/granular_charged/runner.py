@@ -21,7 +21,6 @@ import resource
 import shutil
 import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
@@ -210,25 +209,7 @@ class Runner:
         self.timeout = timeout
         self.render = render
         self.checkpoint = checkpoint
-        self._slots = contextlib.nullcontext()
-        self._stopped = False
         self.show_progress = False     # a tqdm bar per deposition (run; a sweep of one job)
-
-    @contextlib.contextmanager
-    def at_most(self, jobs: int):
-        """Within: at most `jobs` LAMMPS runs of this runner at a time, whichever threads start
-        them, so that a study's depositions and its Table 2 runs share the cores (a run's wall
-        time counts from when it has its slot). Left by an exception (Ctrl-C): the runs still
-        waiting for a slot do not start (RunError)."""
-        self._slots = threading.BoundedSemaphore(max(1, jobs))
-        self._stopped = False
-        try:
-            yield self
-        except BaseException:
-            self._stopped = True
-            raise
-        finally:
-            self._slots = contextlib.nullcontext()
 
     # ---- one deck -------------------------------------------------------------------------
     def run_deck(self, deck: str, workdir: Path, variables: dict, kind: str = "none",
@@ -251,18 +232,15 @@ class Runner:
             log.debug("run: %s", " ".join(cmd))
             env = self.build.child_env()
             env[PARENT_ENV] = str(os.getpid())    # the child exits when this process dies
-            with self._slots:
-                if self._stopped:
-                    raise RunError(f"{workdir}: not started (the study was stopped)")
-                t0 = time.monotonic()
-                ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-                if self.show_progress and kind == "deposition":
-                    r = self._watch(cmd, env, workdir, kind)
-                else:
-                    r = subprocess.run(cmd, env=env, capture_output=True, text=True,
-                                       timeout=self.timeout)
-                wall = time.monotonic() - t0
-                ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            t0 = time.monotonic()
+            ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            if self.show_progress and kind == "deposition":
+                r = self._watch(cmd, env, workdir, kind)
+            else:
+                r = subprocess.run(cmd, env=env, capture_output=True, text=True,
+                                   timeout=self.timeout)
+            wall = time.monotonic() - t0
+            ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         res_file = workdir / "lammps.json"
         if r.returncode != 0 or not res_file.exists():
             logf = workdir / "log.lammps"
@@ -371,12 +349,15 @@ class Runner:
             raise ParamError(f"tracer = {tracer}: must be a particle id 1..N = {p.N} (0: none)")
 
     def deposition(self, p: DepositionParams, root: Path, force: bool = False,
-                   tracer: int = 0) -> dict:
+                   tracer: int = 0, lock: bool = False) -> dict:
         """Run in.deposition for p in root/<p.key()>, analyse, write result.json, return it.
         A complete result.json is returned unchanged (with 'skipped': True) unless force.
-        The run holds root/.<key>.lock meanwhile (see folder_lock)."""
+        lock: hold root/.<key>.lock meanwhile (folder_lock; the `run` command, which runs
+        outside the workflow engine and its lock)."""
         self.check(p, tracer)
         wd = self.workdir(p, root)
+        if not lock:
+            return self._deposition(p, wd, force, tracer)
         with folder_lock(Path(root) / f".{wd.name}.lock", p.key()):
             return self._deposition(p, wd, force, tracer)
 
