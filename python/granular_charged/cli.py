@@ -8,6 +8,7 @@ its claims not yet covered). ``-v``/``-q`` set the log level; ``--build-dir`` th
 from __future__ import annotations
 
 import argparse
+import errno
 import logging
 import sys
 from pathlib import Path
@@ -641,7 +642,11 @@ def main(argv=None) -> int:
         return 1
     except OSError as e:
         # a folder that cannot be made or written (permissions, a full disk, ...)
-        log.error("granular-charged %s: %s", a.command, e)
+        if e.errno == errno.ENOSPC:
+            where = Path(e.filename).parent if e.filename else Path(getattr(a, "out", "."))
+            log.error("granular-charged %s: no space left in %s", a.command, where)
+        else:
+            log.error("granular-charged %s: %s", a.command, e)
         return 1
     except KeyboardInterrupt:
         log.error("interrupted: finished runs are kept; run the same command again to resume")

@@ -228,9 +228,13 @@ class Engine:
         the finished targets, with elapsed time and ETA; logs each case as it finishes."""
         logfile = root / PLAN_DIR / f"snakemake-{time.strftime('%Y%m%d-%H%M%S')}-{os.getpid()}.log"
         seen = set(before)
+        t0 = time.monotonic()
+        pos = 0
         with open(logfile, "w") as fh:
+            # a group of its own, so that an interruption reaches Snakemake, its jobs and their
+            # LAMMPS children together, as a Ctrl-C at a terminal does
             proc = subprocess.Popen(self.command(root, plan), env=_job_env(), stdout=fh,
-                                    stderr=subprocess.STDOUT, text=True)
+                                    stderr=subprocess.STDOUT, text=True, start_new_session=True)
             alive = root / PLAN_DIR / f"engine-{socket.gethostname()}-{proc.pid}"
             alive.touch()
             try:
@@ -243,12 +247,15 @@ class Engine:
                             rc = proc.wait(timeout=1.0)
                         except subprocess.TimeoutExpired:
                             rc = None
+                        pos = _relay(logfile, pos)
                         new = [t for t in targets if t not in seen and t.exists()]
                         for t in new:
                             seen.add(t)
                             bar.update(1)
                             line = describe(t) if describe else None
-                            log.info("[%d/%d] %s", len(seen), len(targets),
+                            log.info("%s %s", progress(len(seen) - len(before),
+                                                       len(targets) - len(before), len(targets),
+                                                       time.monotonic() - t0),
                                      line or t.parent.relative_to(root))
                         if rc is not None:
                             alive.unlink(missing_ok=True)
@@ -256,13 +263,44 @@ class Engine:
             except BaseException:
                 # Ctrl-C: Snakemake stops its running jobs (their targets stay missing)
                 if proc.poll() is None:
-                    proc.send_signal(signal.SIGINT)
+                    _signal_group(proc.pid, signal.SIGINT)
                     try:
                         proc.wait(timeout=60)
                     except subprocess.TimeoutExpired:
-                        proc.kill()
+                        _signal_group(proc.pid, signal.SIGKILL)
                         proc.wait()
                 raise
+
+
+def progress(new_done: int, todo: int, total: int, elapsed: float) -> str:
+    """'[done/total cases, elapsed T, ETA T]', the ETA from the mean time of the cases this
+    study finished so far (those finished before do not make it look faster)."""
+    left = todo - new_done
+    eta = tqdm.format_interval(elapsed / new_done * left) if new_done else "?"
+    return (f"[{total - left}/{total} cases, elapsed {tqdm.format_interval(elapsed)}, "
+            f"ETA {eta}]")
+
+
+def _relay(logfile: Path, pos: int) -> int:
+    """Relay the cases' marked log lines written to Snakemake's log since byte pos."""
+    from .logs import relay_case_line
+    try:
+        with open(logfile, "rb") as fh:
+            fh.seek(pos)
+            chunk = fh.read()
+    except OSError:
+        return pos
+    end = chunk.rfind(b"\n") + 1
+    for line in chunk[:end].decode(errors="replace").splitlines():
+        relay_case_line(line, log)
+    return pos + end
+
+
+def _signal_group(pid: int, sig):
+    try:
+        os.killpg(pid, sig)
+    except ProcessLookupError:
+        pass
 
 
 def _engines_alive(root: Path) -> bool:

@@ -15,10 +15,10 @@ from .engine import FAILED
 def run(plan_path: str, folder: str) -> int:
     from .after_formation import run_table2
     from .lammps_build import BuildError, LammpsBuild
-    from .logs import setup_logging
+    from .logs import setup_case_logging
     from .params import DepositionParams, ParamError
     from .runner import RunError, Runner
-    setup_logging(0, 0)
+    setup_case_logging()
     plan = json.loads(Path(plan_path).read_text())
     job = next(j for j in plan["jobs"] if j["folder"] == folder)
     root = Path(plan["root"])

@@ -127,7 +127,7 @@ def test_deck_variables_come_from_the_deck_file(monkeypatch):
     (["run", "--N", "-5"], ["argument --N: must be >= 1, not -5"]),
     (["sweep", "--out", "r", "--N", "0"], ["argument --N: must be >= 1"]),
     (["run", "--np", "0"], ["argument --np: must be >= 1, not 0"]),
-    (["sweep", "--out", "r", "--jobs", "0"], ["argument --jobs: must be >= 1"]),
+    (["sweep", "--out", "r", "--jobs", "0"], ["argument --jobs/--cores: must be >= 1"]),
     (["demo", "--np", "0"], ["argument --np: must be >= 1"]),
     (["run", "--seed", "0"], ["argument --seed: must be >= 1"]),
     (["run", "--N", "5", "--tracer", "9"], ["tracer = 9: must be a particle id 1..N = 5"]),

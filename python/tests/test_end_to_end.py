@@ -19,6 +19,7 @@ asserted): at test sizes its effect is within the seed-to-seed scatter.
 import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -89,15 +90,17 @@ def test_interrupted_sweep_resumes(study):
     assert "interrupted" in study["interrupted_err"]
     # the finished run was not run again, the interrupted one was run from scratch
     assert study["first"].stat().st_mtime_ns == study["first_mtime"]
-    assert "2 runs, 1 finished before (skipped), 1 to run" in study["stderr"]
+    # the two depositions and the Table 2 check: the first deposition (and the check when it
+    # came before the interrupted run) finished before
+    assert re.search(r"3 cases, [12] finished before, [12] to run", study["stderr"]), study["stderr"]
     assert "incomplete run folder (interrupted?), running it again" in study["stderr"]
     assert (study["second"] / "result.json").exists()
     assert len(results(study)) == 2
 
 
 def test_progress_lines_have_counts_elapsed_eta(study):
-    line = [ln for ln in study["stderr"].splitlines() if "runs, elapsed" in ln]
-    assert line and line[-1].startswith("[2/2 runs, elapsed 00:") and "ETA 00:00]" in line[-1]
+    line = [ln for ln in study["stderr"].splitlines() if "cases, elapsed" in ln]
+    assert line and line[-1].startswith("[3/3 cases, elapsed 00:") and "ETA 00:00]" in line[-1]
 
 
 def test_results_json_is_what_lammps_returned(study):

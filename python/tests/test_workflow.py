@@ -55,8 +55,12 @@ def test_killed_study_resumes_with_only_its_missing_runs(build_dir, tmp_path):
         assert proc.poll() is None, finish(proc)
         assert time.monotonic() - t0 < 300, "no run finished in 300 s"
         time.sleep(0.2)
-    # the whole study at once (engine, its jobs and their LAMMPS children), as a lost node
+    # the whole study at once, as a lost node: the command, and the engine with its jobs and
+    # their LAMMPS children (a process group of its own, named by its engine-<host>-<pid> file)
+    engines = list((out / ".gc-workflow").glob("engine-*"))
     os.killpg(proc.pid, signal.SIGKILL)
+    for f in engines:
+        os.killpg(int(f.name.rsplit("-", 1)[1]), signal.SIGKILL)
     proc.wait()
     done = results(out)
     assert 2 <= len(done) < RUNS, "the study was not interrupted mid-way"
@@ -66,6 +70,7 @@ def test_killed_study_resumes_with_only_its_missing_runs(build_dir, tmp_path):
     log = finish(resumed)
     assert resumed.returncode == 0, log
     assert f"{len(done)} finished before, {RUNS - len(done)} to run" in log, log
+    assert "the lock left by a study that was killed is removed" in log, log
     after = results(out)
     assert len(after) == RUNS
     # the runs finished before the kill were not run again
