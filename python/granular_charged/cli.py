@@ -199,7 +199,7 @@ def build_parser() -> argparse.ArgumentParser:
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     _study_options(p, "reproduce", "deck variables for every run (e.g. --var theta_crit 0.04)",
                    "the tables, claims and figures of the runs finished in --out so far (a "
-                   "study that grows over several sittings)")
+                   "study that grows run by run)")
     p.add_argument("--size", choices=["demo", "quick", "paper"], default="demo",
                    help="demo: N = 500 in L = 14 r_p (default); quick: N = 200 in L = 9 r_p, "
                         "charges 0 200 300 400 450, Table 2 at 400 only; paper: N = 2000 in "

@@ -1,4 +1,4 @@
-"""What the command line refuses before it starts LAMMPS (issue 28, items 3 and 6), the result
+"""What the command line refuses before it starts LAMMPS, the result
 files it will not use, the summary's run count, the folder lock, and the package's import graph.
 
 None of these needs a LAMMPS build: the command line runs with GC_BUILD_DIR naming a folder

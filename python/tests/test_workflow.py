@@ -32,7 +32,7 @@ def env_for(build_dir, **extra):
 
 
 def start(build_dir, args, cwd, **extra):
-    """The command line in a session of its own (so that the test can kill all of it)."""
+    """The command line in a process group of its own (so that the test can kill all of it)."""
     return subprocess.Popen([sys.executable, "-m", "granular_charged"] + [str(a) for a in args],
                             cwd=cwd, env=env_for(build_dir, **extra), stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, text=True, start_new_session=True)
