@@ -36,6 +36,10 @@ in L = 14 r_p, or with --quick N = 200 in L = 9 r_p and five charges (the paper'
 three seeds, one particle per r_p of fall (doc/deposition.md)."""
 
 
+class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
+    """Every option's default in --help; descriptions as written (their own line breaks)."""
+
+
 def _count(text: str) -> int:
     """argparse type: a whole number >= 1 (particles, ranks, jobs)."""
     try:
@@ -129,6 +133,7 @@ def build_parser() -> argparse.ArgumentParser:
                     "sweeps, tables and the paper's figures.",
         epilog="Run 'granular-charged <command> --help' for a command's options. "
                "Documentation: doc/python.md.")
+    ap.formatter_class = HelpFormatter
     ap.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = ap.add_subparsers(dest="command", metavar="command", required=True)
 
@@ -136,7 +141,7 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Run one deposition (the package's in.deposition deck) in "
                                    "OUT/<key>/ and write result.json there; a finished run is "
                                    "not run again unless --force.")
-    p.add_argument("--out", default="runs", help="parent folder of the run folder (default runs)")
+    p.add_argument("--out", default="runs", help="parent folder of the run folder")
     p.add_argument("--seed", type=_count, default=4711)
     p.add_argument("--force", action="store_true", help="run again even if finished")
     _deck_options(p, many=False)
@@ -148,7 +153,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="results folder (one sub-folder per run)")
     p.add_argument("--preset", choices=["paper"], help="the paper's full set of cases")
     p.add_argument("--seeds", type=_count, nargs="+", default=[4711],
-                   help="seeds of the injection positions (default 4711)")
+                   help="seeds of the injection positions")
     engine_options(p)
     p.add_argument("--figures", default=None, metavar="DIR", help="then draw the figures here")
     _deck_options(p, many=True)
@@ -185,7 +190,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "Table 2. Resumable.")
     p.add_argument("formed", help="run folder of a finished neutral deposition")
     p.add_argument("--q", type=float, nargs="+", default=[0.0, 260.0, 400.0],
-                   help="charges [e0] given after formation (default 0 260 400; 0: the control)")
+                   help="charges [e0] given after formation (0: the control)")
     p.add_argument("--out", required=True, help="folder of the Table 2 runs")
     p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
                    help="a variable of in.charged-after-formation for every run (the formed "
@@ -248,22 +253,24 @@ def build_parser() -> argparse.ArgumentParser:
                                    "restart point every --checkpoint particles and an "
                                    "interrupted one goes on from there.")
     p.add_argument("--checkpoint", type=int, default=50, metavar="K",
-                   help="particles between restart points (default 50; 0: none)")
+                   help="particles between restart points (0: none)")
 
     p = sub.add_parser("demo", parents=[common],
                        help="the reduced Fig. 2 study: runs, table, Table 2, figures",
                        description=DEMO_DESCRIPTION,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     _study_options(p, "demo", "deck variables besides the demo's L_rp 14, inject rain, gap_rp 1")
-    p.add_argument("--N", type=_count, default=500, help="particles per run (default 500)")
+    p.add_argument("--N", type=_count, default=500, help="particles per run")
     p.add_argument("--q", type=float, nargs="+", default=[0.0, 260.0, 400.0],
-                   help="charges [e0] (default 0 260 400)")
+                   help="charges [e0]")
     p.add_argument("--table2-q", type=float, nargs="*", default=[0.0, 260.0, 400.0],
                    help="charges of the Table 2 check (none: skip it)")
     p.add_argument("--tracer", type=int, default=None,
-                   help="particle id to follow in the first seed's runs (default N/2)")
+                   help="particle id to follow in the first seed's runs (default: N/2)")
     p.add_argument("--claims", action="store_true",
                    help="then list the paper's claims with what this package checks of each")
+    for command in sub.choices.values():
+        command.formatter_class = HelpFormatter
     return ap
 
 
@@ -271,9 +278,9 @@ def _study_options(p: argparse.ArgumentParser, name: str, var_help: str,
                    finished_only: str | None = None):
     """Options that the studies share; finished_only: what --finished-only prints (the study
     has the option when given)."""
-    p.add_argument("--out", default=f"{name}-output", help=f"output folder (default {name}-output)")
+    p.add_argument("--out", default=f"{name}-output", help="output folder")
     p.add_argument("--seeds", type=_count, nargs="+", default=[1, 2, 3],
-                   help="seeds of the injection positions (default 1 2 3)")
+                   help="seeds of the injection positions")
     p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
                    help=var_help)
     engine_options(p)

@@ -131,7 +131,7 @@ def test_deck_variables_come_from_the_deck_file(monkeypatch):
     (["demo", "--np", "0"], ["argument --np: must be >= 1"]),
     (["run", "--seed", "0"], ["argument --seed: must be >= 1"]),
     (["run", "--N", "5", "--tracer", "9"], ["tracer = 9: must be a particle id 1..N = 5"]),
-    (["run", "--U0", "0"], ["U0 = 0: must be > 0"]),
+    (["run", "--U0", "0"], ["U0 = 0: must be finite and > 0"]),
 ])
 def test_bad_values_refused_before_lammps(tmp_path, args, words):
     # before: --N 0 ran LAMMPS, then a traceback and no result.json; --np 0 ran serial
