@@ -38,7 +38,7 @@ DECK_RANGES = {
     "seq_gap_rp": (lambda x: x >= 0, ">= 0 (0: the deck's interval)"),
     "dt_div": (lambda x: x > 0, "> 0"),
     "accuracy": (lambda x: x > 0, "> 0"),
-    "ke_stop": (lambda x: x > 0, "> 0"),
+    "ke_stop": (lambda x: x >= 0, ">= 0 (0: settle for settle_max)"),
     "E0": (lambda x: True, "a field [V/m]"),
 }
 DECK_WORDS = {"pair_opt": ("yes", "no"), "inject": ("auto", "rain", "plane", "sequential"),
