@@ -349,9 +349,11 @@ def _drop_unusable(root: Path, case: Case):
 
 
 def minutes_for(cpu_s: float, factor: float, np_ranks: int) -> int:
-    """A time limit [min] for a case of estimated CPU time cpu_s (x/ factor) on np_ranks:
-    the estimate's upper bound spread over the ranks, times TIME_MARGIN, at least MIN_MINUTES."""
-    return max(MIN_MINUTES, math.ceil(cpu_s * factor * TIME_MARGIN / max(1, np_ranks) / 60))
+    """A time limit [min] for a case of estimated CPU time cpu_s (x/ factor): the estimate's
+    upper bound times TIME_MARGIN, at least MIN_MINUTES. Not divided by the np_ranks: a bed of
+    a few thousand particles gains far less than the ranks from them, and a limit too short
+    loses the run while one too long only waits longer in the queue."""
+    return max(MIN_MINUTES, math.ceil(cpu_s * factor * TIME_MARGIN / 60))
 
 
 def deposition_cases(params, runs_folder: str, np_ranks: int, tracer=0, calibrate=()) -> list[Case]:
