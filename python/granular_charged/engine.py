@@ -132,10 +132,12 @@ class Engine:
                 defaults.append(f"mem_mb={int(self.mem_mb)}")
             if self.slurm:
                 cmd.append("--slurm")
+                # Snakemake evaluates a resource's value as Python: a quoted string stays a
+                # name (an account called `max` is not the builtin)
                 if self.account:
-                    defaults.append(f"slurm_account={shlex.quote(self.account)}")
+                    defaults.append(f"slurm_account={self.account!r}")
                 if self.partition:
-                    defaults.append(f"slurm_partition={shlex.quote(self.partition)}")
+                    defaults.append(f"slurm_partition={self.partition!r}")
             else:
                 cmd += ["--cluster", self.cluster]
             if defaults:
