@@ -381,7 +381,7 @@ def _runner(a, render=True):
 
 
 def _engine(a):
-    from .engine import Engine
+    from .studies.engine import Engine
     return Engine.from_args(a)
 
 
@@ -626,7 +626,7 @@ def main(argv=None) -> int:
     verbose, quiet = getattr(a, "verbose", 0), getattr(a, "quiet", 0)
     setup_logging(verbose, quiet)
     a.progress = quiet == 0 and sys.stderr.isatty()
-    from .engine import DryRunDone, EngineError
+    from .studies.engine import DryRunDone, EngineError
     from .lammps_build import BuildError
     from .params import ParamError
     from .runner import RunError

@@ -1,7 +1,7 @@
 """One runner for the studies of the command line (``demo`` and ``reproduce``): the depositions
 of a list of cases and seeds (a resumable sweep), runs.csv and summary.csv, the Table 2 check on
 the first neutral packing of the Fig. 2 case (or on each, :meth:`Study.table2_seeds`), and
-the figures, all in one folder: one workflow of the engine (granular_charged.engine), in which
+the figures, all in one folder: one workflow of the engine (granular_charged.studies.engine), in which
 the Table 2 runs start as soon as their packing is there, beside the remaining depositions.
 
 A study says which runs it wants (:meth:`Study.params`), which particle to follow
@@ -18,7 +18,7 @@ from pathlib import Path
 
 from . import figures, tables
 from .after_formation import load_table2
-from .engine import MIN_MINUTES, Engine, deposition_cases, table2_case
+from .studies.engine import MIN_MINUTES, Engine, deposition_cases, table2_case
 from .params import DepositionParams
 from .runner import Runner
 from .sweep import describe_result, finished_results

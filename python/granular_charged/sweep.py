@@ -1,6 +1,6 @@
 """Parameter sweeps over q, r_p, U_0, gamma (and seeds): one folder and one result.json per run,
-run by the workflow engine (granular_charged.engine): finished runs kept (resumable), a progress
-bar with runs done/total, elapsed time and ETA, and one log line per finished run.
+run by the workflow engine (granular_charged.studies.engine): finished runs kept (resumable), a
+progress bar with runs done/total, elapsed time and ETA, and one log line per finished run.
 
 The paper's full set (its Figs. 2, 3a-c, 5a-c, 9, 10; N = 2000, L = 28 r_p, hours):
   granular-charged sweep --preset paper --N 2000 --seeds 1 2 3 --out paper-results --figures paper-figures
@@ -13,7 +13,7 @@ import logging
 from pathlib import Path
 from types import MappingProxyType
 
-from .engine import Engine, deposition_cases
+from .studies.engine import Engine, deposition_cases
 from .params import DepositionParams
 from .runner import Runner, load_result_files, read_result
 

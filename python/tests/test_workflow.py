@@ -1,4 +1,4 @@
-"""Studies run through the workflow engine (Snakemake, granular_charged.engine): an interrupted
+"""Studies run through the workflow engine (Snakemake, granular_charged.studies.engine): an interrupted
 study resumes with only its missing runs and ends as a clean one; the Slurm path through
 stand-in sbatch/sacct commands carries each run's ranks, time and resources; a second study on
 the folder of a running one is refused and nothing is corrupted."""
@@ -113,7 +113,7 @@ def test_study_through_slurm_carries_ranks_time_and_resources(build_dir, tmp_pat
         for want in ("-A standin-account", "-p standin-part", "-t 10", "--ntasks=2",
                      "--cpus-per-task=1", "--mem 500"):
             assert want in words, (want, words)
-        assert "granular_charged.one_case" not in words or "--slurm-jobstep" in words
+        assert "granular_charged.run.one_case" not in words or "--slurm-jobstep" in words
     done = results(out)
     assert len(done) == 2
     # each job ran its case with the requested ranks

@@ -3,7 +3,7 @@
 A study is a list of independent cases, each a folder whose target file says it is finished:
 ``result.json`` for a deposition, ``table2.csv`` for the Table 2 check of a formed packing (which
 needs that packing's result.json first). The package writes the list into a plan (JSON) and runs
-the package's one Snakefile on it; each Snakemake job runs ``python -m granular_charged.one_case``
+the package's one Snakefile on it; each Snakemake job runs ``python -m granular_charged.run.one_case``
 for one folder, which writes the target atomically at its end. So Snakemake's own rules give the
 rest: a target that exists is never run again (an interrupted study resumes with only the
 missing cases), at most ``--jobs`` cases (or cores) at a time locally, one Slurm job per case with
@@ -101,7 +101,7 @@ class Engine:
         plan_dir = root / PLAN_DIR
         plan_dir.mkdir(parents=True, exist_ok=True)
         path = plan_dir / f"plan-{os.getpid()}-{time.time_ns()}.json"
-        command = (f"{shlex.quote(sys.executable)} -m granular_charged.one_case "
+        command = (f"{shlex.quote(sys.executable)} -m granular_charged.run.one_case "
                    f"{shlex.quote(str(path))}")
         plan = {"root": str(root), "build_dir": str(runner.build.path), "render": runner.render,
                 "checkpoint": runner.checkpoint, "timeout": runner.timeout, "command": command,
@@ -285,7 +285,7 @@ def progress(new_done: int, todo: int, total: int, elapsed: float) -> str:
 
 def _relay(logfile: Path, pos: int) -> int:
     """Relay the cases' marked log lines written to Snakemake's log since byte pos."""
-    from .logs import relay_case_line
+    from ..logs import relay_case_line
     try:
         with open(logfile, "rb") as fh:
             fh.seek(pos)
@@ -327,7 +327,7 @@ def _engines_alive(root: Path) -> bool:
 def _job_env() -> dict:
     """The environment of Snakemake and its jobs: this package first on PYTHONPATH."""
     env = dict(os.environ)
-    here = str(Path(__file__).resolve().parents[1])
+    here = str(Path(__file__).resolve().parents[2])
     env["PYTHONPATH"] = os.pathsep.join([here] + [p for p in env.get("PYTHONPATH", "").split(
         os.pathsep) if p and p != here])
     return env
@@ -336,8 +336,8 @@ def _job_env() -> dict:
 def _drop_unusable(root: Path, case: Case):
     """A target that exists but cannot be used (garbage, an older version, wrong types) is
     removed, so that the engine runs its case again."""
-    from .after_formation import table2_complete
-    from .runner import read_result
+    from ..after_formation import table2_complete
+    from ..runner import read_result
     path = root / case.target
     if not path.exists():
         return
@@ -361,7 +361,7 @@ def minutes_for(cpu_s: float, factor: float, np_ranks: int) -> int:
 def deposition_cases(params, runs_folder: str, np_ranks: int, tracer=0, calibrate=()) -> list[Case]:
     """The cases of depositions (runs_folder/<key>, relative to the study's root), each with
     its time limit from the cost estimate (estimate.cpu_seconds)."""
-    from .estimate import cpu_seconds
+    from ..estimate import cpu_seconds
     costs = cpu_seconds(params, calibrate)
     cases = []
     for p, (cpu, factor) in zip(params, costs):
