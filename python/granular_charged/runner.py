@@ -426,7 +426,9 @@ class Runner:
             return done
         point = None if force else restart_point(wd)
         if wd.exists() and point is None:
-            log.info("%s: incomplete run folder (interrupted?), running it again", p.key())
+            # the engine makes a case's folder before it starts the case: empty, it is new
+            if any(wd.iterdir()):
+                log.info("%s: incomplete run folder (interrupted?), running it again", p.key())
             shutil.rmtree(wd)
         if population.is_charged(p.deck_vars()) and not self.build.capabilities["coul/fmm"]:
             raise RunError(f"{p.key()}: charged runs need fix coul/fmm, absent from {self.build.path}")

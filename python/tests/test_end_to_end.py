@@ -54,9 +54,11 @@ def study(cli, build_dir, tmp_path_factory):
     out = tmp_path_factory.mktemp("reproduce")
     runs = out / "runs"
     # 1. start, and interrupt (SIGINT = Ctrl-C) while the second (charged) deposition runs
+    # SIGINT as at a terminal, also when the tests run in the background (which ignores it)
     p = subprocess.Popen([sys.executable, "-m", "granular_charged", *map(str, ARGS), "--out", out],
                          cwd=out, env=_env(build_dir), stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True)
+                         stderr=subprocess.PIPE, text=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     t0 = time.monotonic()
     first = second = None
     while time.monotonic() - t0 < 120 and p.poll() is None:
