@@ -7,8 +7,8 @@ packages=(build-essential cmake ninja-build ccache git xz-utils ca-certificates
           libgtest-dev libgmock-dev libbenchmark-dev libyaml-dev
           python3 python3-numpy python3-scipy python3-matplotlib python3-pytest
           python3-pandas python3-tqdm python3-venv python3-pip python3-setuptools
-          python3-sphinx-argparse
-          python3-sphinx python3-myst-parser python3-sphinx-rtd-theme)
+          python3-sphinx python3-myst-parser python3-sphinx-rtd-theme python3-sphinx-argparse
+          snakemake)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -8,13 +8,12 @@ from __future__ import annotations
 
 import json
 import logging
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from . import tables
 from .deckfile import deck_variables
 from .params import ParamError, coulomb_to_adhesion
-from .runner import RunError, Runner, folder_lock, load_result_files, read_result, write_json
+from .runner import RunError, Runner, load_result_files, read_result, write_json
 
 DECK = "in.charged-after-formation"
 # the variables of a Table 2 run that are not the formed packing's: where it starts from, the
@@ -27,10 +26,9 @@ ROW_KEYS = ("q", "phi_before", "phi_after", "Z_before", "Z_after", "FC_over_FE",
 log = logging.getLogger(__name__)
 
 
-def run_table2(runner: Runner, formed: Path, qs, out: Path, extra: dict | None = None,
-               jobs: int = 1) -> list[dict]:
-    """One charged-after-formation run per charge in out/q<q>/ (resumable; up to `jobs` at a
-    time); writes out/table2.csv (ours beside the paper's Table 2) and returns the rows in the
+def run_table2(runner: Runner, formed: Path, qs, out: Path, extra: dict | None = None) -> list[dict]:
+    """One charged-after-formation run per charge in out/q<q>/, one after the other (a finished
+    one is kept); writes out/table2.csv (atomically, when every charge is done) (ours beside the paper's Table 2) and returns the rows in the
     order of qs. Each run takes the formed run's parameters and every deck variable of it that
     in.charged-after-formation also has (the contact models, the Coulomb solver's settings, the
     slab), then `extra` (variables of that deck)."""
@@ -49,12 +47,8 @@ def run_table2(runner: Runner, formed: Path, qs, out: Path, extra: dict | None =
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
 
-    def one(q) -> dict:
+    def run_one(q) -> dict:
         wd = out / f"q{q:g}"
-        with folder_lock(out / f".{wd.name}.lock", f"table 2, q = {q:g}"):
-            return run_one(q, wd)
-
-    def run_one(q, wd) -> dict:
         rf = wd / "result.json"
         try:
             r = json.loads(rf.read_text())
@@ -80,13 +74,18 @@ def run_table2(runner: Runner, formed: Path, qs, out: Path, extra: dict | None =
                  r["phi_before"], r["phi_after"], r["Z_before"], r["Z_after"], r["wall_s"])
         return r
 
-    if jobs > 1 and len(qs) > 1:
-        with ThreadPoolExecutor(min(jobs, len(qs))) as ex:
-            rows = list(ex.map(one, qs))    # each run is a LAMMPS subprocess
-    else:
-        rows = [one(q) for q in qs]
-    tables.table2_frame(rows).to_csv(out / "table2.csv", index=False)
+    rows = [run_one(q) for q in qs]
+    tmp = out / "table2.csv.tmp"
+    tables.table2_frame(rows).to_csv(tmp, index=False)
+    tmp.replace(out / "table2.csv")
     return rows
+
+
+def table2_complete(folder: Path, qs) -> bool:
+    """Whether folder holds a usable Table 2 run for each charge of qs."""
+    have = {float(r["q"]) for r in load_table2(folder)
+            if isinstance(r.get("q"), (int, float))}
+    return all(float(q) in have for q in qs)
 
 
 

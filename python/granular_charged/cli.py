@@ -8,6 +8,7 @@ its claims not yet covered). ``-v``/``-q`` set the log level; ``--build-dir`` th
 from __future__ import annotations
 
 import argparse
+import errno
 import logging
 import sys
 from pathlib import Path
@@ -33,6 +34,10 @@ U_0 = 0.5, 0.707, 1.414, 2 m/s, gamma = 5, 20 mJ/m^2 and r_p = 1 um (phi and <Z>
 collapse of the charged cases quantified; the paper's Fig. 9), and the Table 2 check. N = 500
 in L = 14 r_p, or with --quick N = 200 in L = 9 r_p and five charges (the paper's particles per floor area),
 three seeds, one particle per r_p of fall (doc/deposition.md)."""
+
+
+class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
+    """Every option's default in --help; descriptions as written (their own line breaks)."""
 
 
 def _count(text: str) -> int:
@@ -96,6 +101,29 @@ def _deck_options(p: argparse.ArgumentParser, many: bool):
     p.add_argument("--no-render", action="store_true", help="no rendered packing image")
 
 
+def engine_options(p: argparse.ArgumentParser):
+    """How a study's runs run: locally, or submitted to Slurm or another batch system (the
+    workflow engine, Snakemake: doc/python.md, "Many runs and clusters")."""
+    g = p.add_argument_group("where the runs run (Snakemake)")
+    g.add_argument("--jobs", "--cores", type=_count, default=1,
+                   help="runs at a time on this machine; with --slurm or --cluster: jobs "
+                        "queued at once")
+    g.add_argument("--slurm", action="store_true",
+                   help="submit each run as a Slurm job (sbatch) with its --np MPI ranks and a "
+                        "time limit from its estimated cost")
+    g.add_argument("--account", default=None, help="Slurm account (sbatch -A)")
+    g.add_argument("--partition", default=None, help="Slurm partition (sbatch -p)")
+    g.add_argument("--mem-mb", type=_count, default=None, metavar="MB",
+                   help="memory per job [MB] on a cluster")
+    g.add_argument("--cluster", default=None, metavar="TEMPLATE",
+                   help="submit each run with this command (Snakemake's --cluster template, e.g. "
+                        "'qsub -l walltime={resources.runtime}:00 -pe mpi {resources.tasks}')")
+    g.add_argument("--dry-run", action="store_true",
+                   help="print the runs that would run or be submitted, run nothing")
+    g.add_argument("--unlock", action="store_true",
+                   help="first remove the lock a killed study left on the folder")
+
+
 def build_parser() -> argparse.ArgumentParser:
     common = _common()
     ap = argparse.ArgumentParser(
@@ -105,6 +133,7 @@ def build_parser() -> argparse.ArgumentParser:
                     "sweeps, tables and the paper's figures.",
         epilog="Run 'granular-charged <command> --help' for a command's options. "
                "Documentation: doc/python.md.")
+    ap.formatter_class = HelpFormatter
     ap.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = ap.add_subparsers(dest="command", metavar="command", required=True)
 
@@ -112,7 +141,7 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Run one deposition (the package's in.deposition deck) in "
                                    "OUT/<key>/ and write result.json there; a finished run is "
                                    "not run again unless --force.")
-    p.add_argument("--out", default="runs", help="parent folder of the run folder (default runs)")
+    p.add_argument("--out", default="runs", help="parent folder of the run folder")
     p.add_argument("--seed", type=_count, default=4711)
     p.add_argument("--force", action="store_true", help="run again even if finished")
     _deck_options(p, many=False)
@@ -124,8 +153,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="results folder (one sub-folder per run)")
     p.add_argument("--preset", choices=["paper"], help="the paper's full set of cases")
     p.add_argument("--seeds", type=_count, nargs="+", default=[4711],
-                   help="seeds of the injection positions (default 4711)")
-    p.add_argument("--jobs", type=_count, default=1, help="runs at a time")
+                   help="seeds of the injection positions")
+    engine_options(p)
     p.add_argument("--figures", default=None, metavar="DIR", help="then draw the figures here")
     _deck_options(p, many=True)
 
@@ -134,7 +163,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "protocol, grid, seeds; doc/populations.md), resumably, then its "
                                    "tables and figures (labelled with its name) in its out folder.")
     p.add_argument("file", help="the study file (TOML)")
-    p.add_argument("--jobs", type=_count, default=1, help="runs at a time")
+    engine_options(p)
     p.add_argument("--np", type=_count, default=1, help="MPI ranks per run")
     p.add_argument("--no-render", action="store_true", help="no rendered packing images")
     p.add_argument("--estimate-only", action="store_true",
@@ -161,12 +190,11 @@ def build_parser() -> argparse.ArgumentParser:
                                    "Table 2. Resumable.")
     p.add_argument("formed", help="run folder of a finished neutral deposition")
     p.add_argument("--q", type=float, nargs="+", default=[0.0, 260.0, 400.0],
-                   help="charges [e0] given after formation (default 0 260 400; 0: the control)")
+                   help="charges [e0] given after formation (0: the control)")
     p.add_argument("--out", required=True, help="folder of the Table 2 runs")
     p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
                    help="a variable of in.charged-after-formation for every run (the formed "
                         "run's own settings are taken over), e.g. --var relax_rp 50")
-    p.add_argument("--jobs", type=_count, default=1, help="runs at a time")
     p.add_argument("--np", type=_count, default=1, help="MPI ranks per run")
 
     p = sub.add_parser("reproduce", parents=[common],
@@ -176,7 +204,7 @@ def build_parser() -> argparse.ArgumentParser:
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     _study_options(p, "reproduce", "deck variables for every run (e.g. --var theta_crit 0.04)",
                    "the tables, claims and figures of the runs finished in --out so far (a "
-                   "study that grows over several sittings)")
+                   "study that grows run by run)")
     p.add_argument("--size", choices=["demo", "quick", "paper"], default="demo",
                    help="demo: N = 500 in L = 14 r_p (default); quick: N = 200 in L = 9 r_p, "
                         "charges 0 200 300 400 450, Table 2 at 400 only; paper: N = 2000 in "
@@ -225,22 +253,24 @@ def build_parser() -> argparse.ArgumentParser:
                                    "restart point every --checkpoint particles and an "
                                    "interrupted one goes on from there.")
     p.add_argument("--checkpoint", type=int, default=50, metavar="K",
-                   help="particles between restart points (default 50; 0: none)")
+                   help="particles between restart points (0: none)")
 
     p = sub.add_parser("demo", parents=[common],
                        help="the reduced Fig. 2 study: runs, table, Table 2, figures",
                        description=DEMO_DESCRIPTION,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     _study_options(p, "demo", "deck variables besides the demo's L_rp 14, inject rain, gap_rp 1")
-    p.add_argument("--N", type=_count, default=500, help="particles per run (default 500)")
+    p.add_argument("--N", type=_count, default=500, help="particles per run")
     p.add_argument("--q", type=float, nargs="+", default=[0.0, 260.0, 400.0],
-                   help="charges [e0] (default 0 260 400)")
+                   help="charges [e0]")
     p.add_argument("--table2-q", type=float, nargs="*", default=[0.0, 260.0, 400.0],
                    help="charges of the Table 2 check (none: skip it)")
     p.add_argument("--tracer", type=int, default=None,
-                   help="particle id to follow in the first seed's runs (default N/2)")
+                   help="particle id to follow in the first seed's runs (default: N/2)")
     p.add_argument("--claims", action="store_true",
                    help="then list the paper's claims with what this package checks of each")
+    for command in sub.choices.values():
+        command.formatter_class = HelpFormatter
     return ap
 
 
@@ -248,12 +278,12 @@ def _study_options(p: argparse.ArgumentParser, name: str, var_help: str,
                    finished_only: str | None = None):
     """Options that the studies share; finished_only: what --finished-only prints (the study
     has the option when given)."""
-    p.add_argument("--out", default=f"{name}-output", help=f"output folder (default {name}-output)")
+    p.add_argument("--out", default=f"{name}-output", help="output folder")
     p.add_argument("--seeds", type=_count, nargs="+", default=[1, 2, 3],
-                   help="seeds of the injection positions (default 1 2 3)")
+                   help="seeds of the injection positions")
     p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"),
                    help=var_help)
-    p.add_argument("--jobs", type=_count, default=1, help="runs at a time")
+    engine_options(p)
     p.add_argument("--np", type=_count, default=1, help="MPI ranks per run")
     p.add_argument("--no-render", action="store_true", help="no rendered packing images")
     if finished_only:
@@ -350,6 +380,11 @@ def _runner(a, render=True):
                   checkpoint=getattr(a, "checkpoint", 0))
 
 
+def _engine(a):
+    from .studies.engine import Engine
+    return Engine.from_args(a)
+
+
 def cmd_run(a) -> int:
     from .runner import RunError, Runner
     from .sweep import fmt
@@ -368,7 +403,7 @@ def cmd_run(a) -> int:
     runner.show_progress = a.progress
     log.info("run %s in %s (LAMMPS build %s)", p.key(), out.resolve(), runner.build.path)
     try:
-        r = runner.deposition(p, out, force=a.force, tracer=a.tracer)
+        r = runner.deposition(p, out, force=a.force, tracer=a.tracer, lock=True)
     except RunError as e:
         log.error("%s", e)
         return 1
@@ -399,8 +434,7 @@ def cmd_sweep(a) -> int:
             log.warning("%d charged runs NOT run: fix coul/fmm is absent from %s", len(skip),
                         runner.build.path)
         params = [p for p in params if not is_charged(p.deck_vars())]
-    runner.show_progress = a.progress and a.jobs == 1
-    res = Sweep(runner, out, jobs=a.jobs, progress=a.progress).run(params, a.tracer)
+    res = Sweep(runner, out, engine=_engine(a)).run(params, a.tracer)
     if figs is not None and params:
         from .tables import variant
         _figures(load_results(out), figs, None, variant(vars(params[0])))
@@ -433,7 +467,7 @@ def cmd_study(a) -> int:
         d = studyfile.load(a.file)
         announce(studyfile.params(d), Path(d["out"]) / "runs", d["protocol"])
         return 0
-    res = studyfile.run(a.file, _runner(a, not a.no_render), jobs=a.jobs, progress=a.progress)
+    res = studyfile.run(a.file, _runner(a, not a.no_render), engine=_engine(a))
     print(res["summary"].to_string(index=False))
     for f in res["figures"]:
         print(f)
@@ -458,7 +492,7 @@ def cmd_table2(a) -> int:
     from .params import split_deck_vars
     _, extra = split_deck_vars(a.var, deck_variables(DECK), OWN, DECK)
     out = _out_dir(a.out)
-    rows = run_table2(_runner(a), Path(a.formed), a.q, out, extra, jobs=a.jobs)
+    rows = run_table2(_runner(a), Path(a.formed), a.q, out, extra)
     print(tables.format_table(tables.table2_frame(rows), "{:.5g}"))
     return 0
 
@@ -469,7 +503,7 @@ def cmd_reproduce(a) -> int:
     fields, extra = _vars(a, "reproduce")
     study = Reproduction(out=_out_dir(a.out), size_name=a.size, seeds=tuple(a.seeds),
                          extra=extra, fields=fields, jobs=a.jobs, progress=a.progress,
-                         finished_only=a.finished_only)
+                         finished_only=a.finished_only, engine=_engine(a))
     for p in study.params(True):
         Runner.check(p, study.tracer(p))
     res = study.run(_runner(a, not a.no_render))
@@ -485,7 +519,7 @@ def cmd_demo(a) -> int:
     fields, extra = _vars(a, "demo")
     study = Demo(out=_out_dir(a.out), N=a.N, qs=tuple(a.q), seeds=tuple(a.seeds),
                  table2_qs=tuple(a.table2_q), extra={**DEMO_VARS, **extra}, fields=fields,
-                 jobs=a.jobs, progress=a.progress, follow=a.tracer)
+                 jobs=a.jobs, progress=a.progress, follow=a.tracer, engine=_engine(a))
     for p in study.params(True):
         Runner.check(p, study.tracer(p))
     res = study.run(_runner(a, not a.no_render))
@@ -503,7 +537,7 @@ def _study_runs(a, params) -> tuple[Path, list[dict]]:
     out = _out_dir(a.out)
     runs = out / "runs"
     if not a.finished_only:
-        Sweep(_runner(a, not a.no_render), runs, jobs=a.jobs, progress=a.progress).run(params)
+        Sweep(_runner(a, not a.no_render), runs, engine=_engine(a)).run(params)
     keys = {p.key() for p in params}
     results = [r for r in load_results(runs) if r["key"] in keys] if runs.exists() else []
     if not results:
@@ -592,11 +626,17 @@ def main(argv=None) -> int:
     verbose, quiet = getattr(a, "verbose", 0), getattr(a, "quiet", 0)
     setup_logging(verbose, quiet)
     a.progress = quiet == 0 and sys.stderr.isatty()
+    from .studies.engine import DryRunDone, EngineError
     from .lammps_build import BuildError
     from .params import ParamError
     from .runner import RunError
     try:
         return COMMANDS[a.command](a)
+    except DryRunDone:
+        return 0
+    except EngineError as e:
+        log.error("granular-charged %s: %s", a.command, e)
+        return 1
     except ParamError as e:
         # before any run: nothing was started or written
         log.error("granular-charged %s: %s", a.command, e)
@@ -609,7 +649,11 @@ def main(argv=None) -> int:
         return 1
     except OSError as e:
         # a folder that cannot be made or written (permissions, a full disk, ...)
-        log.error("granular-charged %s: %s", a.command, e)
+        if e.errno == errno.ENOSPC:
+            where = Path(e.filename).parent if e.filename else Path(getattr(a, "out", "."))
+            log.error("granular-charged %s: no space left in %s", a.command, where)
+        else:
+            log.error("granular-charged %s: %s", a.command, e)
         return 1
     except KeyboardInterrupt:
         log.error("interrupted: finished runs are kept; run the same command again to resume")

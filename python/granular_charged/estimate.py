@@ -100,6 +100,17 @@ def estimate(params, folders=()) -> dict:
             "protocols": protocols}
 
 
+def cpu_seconds(params, folders=()) -> list[tuple[float, float]]:
+    """(CPU seconds, factor of uncertainty) of each run, with one calibration for all."""
+    cal = calibration([f for f in (*folders, KEPT) if Path(f).is_dir()])
+    out = []
+    for p in params:
+        _, n = interval_steps(p)
+        c, f, _ = cal[population.is_charged(p.deck_vars())]
+        out.append((c * p.N ** 2 * n, f))
+    return out
+
+
 def describe(est: dict) -> str:
     def hms(s):
         return f"{s / 3600:.1f} h" if s >= 3600 else f"{s / 60:.1f} min" if s >= 60 else f"{s:.0f} s"

@@ -18,3 +18,27 @@ def setup_logging(verbose: int = 0, quiet: int = 0):
     root.handlers[:] = [handler]
     root.setLevel(max(logging.DEBUG, level))
     root.propagate = False
+
+
+# the lines a case run by the workflow engine logs (in Snakemake's log), which the study's
+# command relays to its own log: CASE_MARK, the level's name, the message
+CASE_MARK = "GC-CASE"
+
+
+def setup_case_logging():
+    """A case run by the engine: its log lines marked for the study's command to relay."""
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter(f"{CASE_MARK} %(levelname)s %(message)s"))
+    root = logging.getLogger("granular_charged")
+    root.handlers[:] = [handler]
+    root.setLevel(logging.DEBUG)
+    root.propagate = False
+
+
+def relay_case_line(line: str, log: logging.Logger) -> bool:
+    """Log a marked line of a case at its level (True), or leave it (False)."""
+    if not line.startswith(CASE_MARK + " "):
+        return False
+    level, _, message = line[len(CASE_MARK) + 1:].rstrip("\n").partition(" ")
+    log.log(getattr(logging, level, logging.INFO), "%s", message)
+    return True

@@ -7,7 +7,7 @@ Runs: q = 260 and 400 e_0 one at a time, the same charges with the default plane
 neutral default rain (phi_0 of phi_0/phi - 1), three seeds each. The default runs are those of
 `reproduce --size paper` (the same folders). A sequential run is ~12 million steps: the study
 leaves restart points (``--checkpoint``, default every 50 particles), so that a run cut off by
-the end of a sitting goes on from there (doc/deposition.md, "Restart points").
+an interruption goes on from there (doc/deposition.md, "Restart points").
 
 Per charge and protocol: phi and <Z> (analysis slab) as mean +- sd over the seeds,
 phi_0/phi - 1 with its standard error, CPU per run; per charge the difference sequential -

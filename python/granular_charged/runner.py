@@ -13,15 +13,16 @@ sequential injection): then the run goes on from it (doc/deposition.md, "Restart
 from __future__ import annotations
 
 import contextlib
+import errno
 import fcntl
 import json
 import logging
+import math
 import os
 import resource
 import shutil
 import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
@@ -59,12 +60,44 @@ class RunError(RuntimeError):
     """A LAMMPS run failed (the message carries the tail of its log)."""
 
 
+def strict(value):
+    """value with every NaN or infinite float as None (strict JSON has no NaN)."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: strict(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [strict(v) for v in value]
+    return value
+
+
 def write_json(path: Path, data: dict):
-    """Write JSON atomically (a temporary file renamed over the target): an interrupted write
-    never leaves a truncated file that looks complete."""
+    """Write strict JSON (NaN and inf as null) atomically (a temporary file renamed over the
+    target): an interrupted write never leaves a truncated file that looks complete; a write
+    that fails (a full disk) leaves no temporary file."""
+    path = Path(path)
     tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(data, indent=1))
-    os.replace(tmp, path)
+    try:
+        tmp.write_text(json.dumps(strict(data), indent=1, allow_nan=False))
+        os.replace(tmp, path)
+    except OSError as e:
+        tmp.unlink(missing_ok=True)
+        raise no_space(e, path.parent) from e
+
+
+def no_space(error: OSError, folder: Path) -> OSError:
+    """A full disk said as such (with the folder); other errors unchanged."""
+    if getattr(error, "errno", None) == errno.ENOSPC:
+        return RunError(f"no space left in {folder}")
+    return error
+
+
+def disk_full(folder: Path, need: int = 1 << 20) -> bool:
+    """Whether the file system of folder has less than `need` bytes free."""
+    try:
+        return shutil.disk_usage(folder).free < need
+    except OSError:
+        return False
 
 
 def result_problem(res) -> str | None:
@@ -79,12 +112,30 @@ def result_problem(res) -> str | None:
         missing += [f"params.{k}" for k in PARAM_KEYS if k not in res["params"]]
     if missing:
         return f"keys missing: {', '.join(dict.fromkeys(missing))}"
+    wrong = [k for k, ok in (("phi", _number_or_none(res["phi"])), ("Z", _number_or_none(res["Z"])),
+                             ("fZ", isinstance(res["fZ"], list)
+                              and all(_number_or_none(x) for x in res["fZ"])),
+                             ("wall_s", _number(res["wall_s"])))
+             if not ok]
+    wrong += [k for k in ("inserted", "natoms", "lost", "flying")
+              if not (isinstance(res[k], int) and not isinstance(res[k], bool))]
+    wrong += [f"params.{k}" for k in PARAM_KEYS if not _number(res["params"][k])]
+    if wrong:
+        return f"values of the wrong type: {', '.join(wrong)}"
     # written before --var was checked: `--var q 400` ran charged with params.q = 0
     shadow = sorted(set(res["params"].get("extra") or {}) & set(res["params"]))
     if shadow:
         return (f"params.extra sets {', '.join(shadow)} beside params' own value (an older "
                 "version's unchecked --var): its parameters do not describe the run")
     return None
+
+
+def _number(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _number_or_none(x) -> bool:
+    return x is None or _number(x)
 
 
 def load_result_files(files, problem=result_problem) -> list[dict]:
@@ -210,25 +261,7 @@ class Runner:
         self.timeout = timeout
         self.render = render
         self.checkpoint = checkpoint
-        self._slots = contextlib.nullcontext()
-        self._stopped = False
         self.show_progress = False     # a tqdm bar per deposition (run; a sweep of one job)
-
-    @contextlib.contextmanager
-    def at_most(self, jobs: int):
-        """Within: at most `jobs` LAMMPS runs of this runner at a time, whichever threads start
-        them, so that a study's depositions and its Table 2 runs share the cores (a run's wall
-        time counts from when it has its slot). Left by an exception (Ctrl-C): the runs still
-        waiting for a slot do not start (RunError)."""
-        self._slots = threading.BoundedSemaphore(max(1, jobs))
-        self._stopped = False
-        try:
-            yield self
-        except BaseException:
-            self._stopped = True
-            raise
-        finally:
-            self._slots = contextlib.nullcontext()
 
     # ---- one deck -------------------------------------------------------------------------
     def run_deck(self, deck: str, workdir: Path, variables: dict, kind: str = "none",
@@ -251,19 +284,20 @@ class Runner:
             log.debug("run: %s", " ".join(cmd))
             env = self.build.child_env()
             env[PARENT_ENV] = str(os.getpid())    # the child exits when this process dies
-            with self._slots:
-                if self._stopped:
-                    raise RunError(f"{workdir}: not started (the study was stopped)")
-                t0 = time.monotonic()
-                ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-                if self.show_progress and kind == "deposition":
-                    r = self._watch(cmd, env, workdir, kind)
-                else:
-                    r = subprocess.run(cmd, env=env, capture_output=True, text=True,
-                                       timeout=self.timeout)
-                wall = time.monotonic() - t0
-                ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            t0 = time.monotonic()
+            ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            if self.show_progress and kind == "deposition":
+                r = self._watch(cmd, env, workdir, kind)
+            else:
+                r = subprocess.run(cmd, env=env, capture_output=True, text=True,
+                                   timeout=self.timeout)
+            wall = time.monotonic() - t0
+            ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         res_file = workdir / "lammps.json"
+        if (r.returncode != 0 or not res_file.exists()) and disk_full(workdir):
+            # LAMMPS's own message would be about the file it could not finish (an empty
+            # particle.mol: "Unexpected end of molecule file")
+            raise RunError(f"no space left in {workdir}")
         if r.returncode != 0 or not res_file.exists():
             logf = workdir / "log.lammps"
             text = logf.read_text(errors="replace") if logf.exists() else ""
@@ -371,12 +405,15 @@ class Runner:
             raise ParamError(f"tracer = {tracer}: must be a particle id 1..N = {p.N} (0: none)")
 
     def deposition(self, p: DepositionParams, root: Path, force: bool = False,
-                   tracer: int = 0) -> dict:
+                   tracer: int = 0, lock: bool = False) -> dict:
         """Run in.deposition for p in root/<p.key()>, analyse, write result.json, return it.
         A complete result.json is returned unchanged (with 'skipped': True) unless force.
-        The run holds root/.<key>.lock meanwhile (see folder_lock)."""
+        lock: hold root/.<key>.lock meanwhile (folder_lock; the `run` command, which runs
+        outside the workflow engine and its lock)."""
         self.check(p, tracer)
         wd = self.workdir(p, root)
+        if not lock:
+            return self._deposition(p, wd, force, tracer)
         with folder_lock(Path(root) / f".{wd.name}.lock", p.key()):
             return self._deposition(p, wd, force, tracer)
 
@@ -389,7 +426,9 @@ class Runner:
             return done
         point = None if force else restart_point(wd)
         if wd.exists() and point is None:
-            log.info("%s: incomplete run folder (interrupted?), running it again", p.key())
+            # the engine makes a case's folder before it starts the case: empty, it is new
+            if any(wd.iterdir()):
+                log.info("%s: incomplete run folder (interrupted?), running it again", p.key())
             shutil.rmtree(wd)
         if population.is_charged(p.deck_vars()) and not self.build.capabilities["coul/fmm"]:
             raise RunError(f"{p.key()}: charged runs need fix coul/fmm, absent from {self.build.path}")
@@ -398,22 +437,42 @@ class Runner:
         variables.setdefault("computes", "1" if self.build.capabilities["packing computes"] else "0")
         if tracer:
             variables["tracer"] = str(tracer)
-        pieces = self._begin_piece(wd, point, variables)
-        lmp = self.run_deck("in.deposition", wd, variables, kind="deposition",
-                            render=self.render and self.build.can_render)
+        restart_note = None
+        try:
+            pieces = self._begin_piece(wd, point, variables)
+            lmp = self.run_deck("in.deposition", wd, variables, kind="deposition",
+                                render=self.render and self.build.can_render)
+        except RunError as e:
+            if point is None or str(e).startswith("no space left"):
+                raise
+            # a restart point LAMMPS cannot read (truncated, emptied): the deck keeps only the
+            # last one, so the run starts afresh, and says so
+            restart_note = (f"its restart point after particle {point['k']} could not be read; "
+                            "the run started afresh")
+            log.warning("%s: %s", p.key(), restart_note)
+            shutil.rmtree(wd)
+            variables.pop("resume", None)
+            point = None
+            pieces = self._begin_piece(wd, None, variables)
+            lmp = self.run_deck("in.deposition", wd, variables, kind="deposition",
+                                render=self.render and self.build.can_render)
         pieces[-1].update(wall_s=lmp["wall_s"], cpu_s=lmp["cpu_s"])
         if len(pieces) > 1:
             write_json(wd / PIECES, pieces)
             lmp["wall_s"] = sum(pc["wall_s"] for pc in pieces)
             lmp["cpu_s"] = sum(pc["cpu_s"] for pc in pieces)
         try:
-            res = self.analyse(wd, p, lmp)
+            res = self.analyse(wd, p, lmp, computes=variables["computes"] == "1")
         except (OSError, ValueError, KeyError, IndexError, TypeError) as e:
             # a run LAMMPS finished but whose output cannot be analysed: an error of this run
             # (no result.json: the folder is run again next time), not a traceback
             raise RunError(f"{p.key()}: the analysis of {wd} failed: {type(e).__name__}: {e}") from e
         res["tracer"] = tracer
         res["np"] = self.np_ranks
+        notes = [n for n in (restart_note, *(pc.get("note") for pc in pieces)) if n]
+        if notes:
+            res["restart_note"] = "; ".join(notes)
+            res["warning"] = "; ".join(filter(None, [res.get("warning"), *notes]))
         log.info("%s: injection protocol %s%s", p.key(), res["protocol"],
                  " (auto)" if p.extra.get("inject", "auto") == "auto" else "")
         if len(pieces) > 1:
@@ -433,8 +492,7 @@ class Runner:
         its later work is done again), as wall and CPU time alike."""
         pieces = []
         if point is not None:
-            with contextlib.suppress(OSError, ValueError):
-                pieces = json.loads((wd / PIECES).read_text())
+            pieces = self._earlier_pieces(wd)
             close_interrupted_pieces(pieces, (wd / CHECKPOINT_VARS).stat().st_mtime)
             variables["resume"] = "yes"
             for name in FOLLOWING_DUMPS:
@@ -455,7 +513,26 @@ class Runner:
         return pieces
 
     @staticmethod
-    def analyse(workdir: Path, p: DepositionParams, lmp: dict) -> dict:
+    def _earlier_pieces(wd: Path) -> list[dict]:
+        """The pieces of pieces.json; when it is unreadable or not a list of pieces, one
+        interrupted piece from the folder's first file (its CPU time is not dropped)."""
+        try:
+            pieces = json.loads((wd / PIECES).read_text())
+            if isinstance(pieces, list) and all(isinstance(pc, dict) and _number(pc.get("start"))
+                                                for pc in pieces) and pieces:
+                return pieces
+        except (OSError, ValueError):
+            pass
+        first = min((f.stat().st_mtime for f in wd.iterdir()
+                     if f.is_file() and not f.name.startswith(("checkpoint", PIECES))),
+                    default=(wd / CHECKPOINT_VARS).stat().st_mtime)
+        note = (f"{PIECES} was unreadable: the earlier pieces are counted as one, from the "
+                "folder's first file to the restart point")
+        log.warning("%s: %s", wd.name, note)
+        return [{"from_particle": 0, "start": first, "note": note}]
+
+    @staticmethod
+    def analyse(workdir: Path, p: DepositionParams, lmp: dict, computes: bool = False) -> dict:
         """result.json: LAMMPS's own numbers (lmp, read from the instance) as phi, Z, fZ, and
         the Python analysis of final.dump beside them (python.*)."""
         snap = packing.read_dump(Path(workdir) / "final.dump", last_only=True)
@@ -471,7 +548,9 @@ class Runner:
             "params": {k: v for k, v in vars(p).items()},
             "groups": p.groups(), "FC_over_FE": coulomb_to_adhesion(p.gamma, p.rp, p.q),
             "lammps": lmp, "python": py,
-            "source": "lammps computes" if from_lammps else "python (no computes in the build)",
+            "source": ("lammps computes" if from_lammps
+                       else "python (no computes in the build)" if not computes
+                       else "python (the bed was too thin for the computes' slab)"),
             "phi": lmp["phi"] if from_lammps else py["phi"],
             "Z": lmp["Z"] if from_lammps else py["Z"],
             "fZ": lmp["fZ"] if from_lammps else py["fZ"],

@@ -1,8 +1,8 @@
 """One runner for the studies of the command line (``demo`` and ``reproduce``): the depositions
 of a list of cases and seeds (a resumable sweep), runs.csv and summary.csv, the Table 2 check on
 the first neutral packing of the Fig. 2 case (or on each, :meth:`Study.table2_seeds`), and
-the figures, all in one folder. The Table 2 runs start as soon as their packing is there, beside
-the remaining depositions (:meth:`Runner.at_most` keeps the LAMMPS runs to ``jobs`` at a time).
+the figures, all in one folder: one workflow of the engine (granular_charged.studies.engine), in which
+the Table 2 runs start as soon as their packing is there, beside the remaining depositions.
 
 A study says which runs it wants (:meth:`Study.params`), which particle to follow
 (:meth:`Study.tracer`), the charges of its Table 2 check (:meth:`Study.table2_charges`) and what
@@ -13,15 +13,15 @@ from __future__ import annotations
 
 import logging
 import time
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import figures, tables
-from .after_formation import load_table2, run_table2
+from .after_formation import load_table2
+from .studies.engine import MIN_MINUTES, Engine, deposition_cases, table2_case
 from .params import DepositionParams
-from .runner import RunError, Runner
-from .sweep import Sweep
+from .runner import Runner
+from .sweep import describe_result, finished_results
 
 log = logging.getLogger(__name__)
 
@@ -55,6 +55,11 @@ class Study:
     jobs: int = 1
     progress: bool = True
     finished_only: bool = False   # run nothing: analyse the runs finished in out so far
+    engine: Engine | None = None  # how the runs run (None: locally, `jobs` at a time)
+
+    def __post_init__(self):
+        if self.engine is None:
+            self.engine = Engine(jobs=self.jobs, progress=self.progress)
 
     # ---- what a study chooses ----------------------------------------------------------------
     def params(self, have_fmm: bool) -> list[DepositionParams]:
@@ -113,32 +118,32 @@ class Study:
         return res
 
     def _run_all(self, runner: Runner, params, out: Path, have_fmm: bool):
-        """The depositions, and the Table 2 check of each chosen packing as soon as that packing
-        is there (beside the remaining depositions: at most self.jobs LAMMPS runs at a time in
-        all); returns the deposition results and the Table 2 rows (packings by seed)."""
+        """The depositions and the Table 2 check of each chosen packing, one workflow (the
+        engine starts a check as soon as its packing is there, beside the remaining
+        depositions); returns the deposition results and the Table 2 rows (packings by seed)."""
         qs = self.table2_charges()
         seeds = self.table2_seeds() if have_fmm and qs else ()
-        checks = {}
-        # the pool last out: a Ctrl-C leaves at_most first, so that a waiting check does not start
-        with ThreadPoolExecutor(1) as pool, runner.at_most(self.jobs):
-            def start_check(p, r):
-                if p.seed in seeds and all(getattr(p, k) == v for k, v in FIG2_CASE.items()) \
-                        and p.seed not in checks:
-                    folder = table2_folder(out, None if p.seed == seeds[0] else p.seed)
-                    # the Table 2 runs take the formed run's settings (run_table2)
-                    checks[p.seed] = pool.submit(run_table2, runner, Path(r["dir"]), qs, folder,
-                                                 jobs=self.jobs)
-            results = Sweep(runner, out / "runs", jobs=self.jobs, progress=self.progress).run(
-                params, tracer=self.tracer, on_result=start_check)
-            t2 = []
-            for seed in sorted(checks):
-                try:
-                    t2 += checks[seed].result()
-                except RunError as e:
-                    log.error("Table 2 check FAILED: %s", e)
+        for p in params:
+            runner.check(p, self.tracer(p))
+        cases = deposition_cases(params, "runs", runner.np_ranks, self.tracer, [out / "runs"])
+        checks = []
         for seed in seeds:
-            if seed not in checks:
-                log.error("Table 2 check not run for seed %d: its neutral packing of the paper's "
-                          "Fig. 2 case is missing (failed, or not in this study)", seed)
+            formed = next((c for p, c in zip(params, cases) if p.seed == seed and all(
+                getattr(p, k) == v for k, v in FIG2_CASE.items())), None)
+            if formed is None:
+                log.error("Table 2 check not run for seed %d: its neutral packing of the "
+                          "paper's Fig. 2 case is not in this study", seed)
+                continue
+            folder = table2_folder(Path(""), None if seed == seeds[0] else seed)
+            # a relaxation of the formed bed per charge: about a tenth of a deposition each
+            checks.append(table2_case(str(folder), formed.folder, qs, {}, runner.np_ranks,
+                                      max(MIN_MINUTES, formed.minutes * len(qs) // 10)))
+        self.engine.run(out, cases + checks, runner, describe=describe_result)
+        results = finished_results(params, out / "runs")
+        t2 = []
+        for c in checks:
+            if (out / c.target).exists():
+                t2 += load_table2(out / c.folder)
+            else:
+                log.error("Table 2 check FAILED or not run: %s", out / c.folder)
         return results, t2
-

@@ -209,7 +209,7 @@ def figures(d: dict, results: list[dict], out: Path) -> list[Path]:
     return paths
 
 
-def run(path, runner, jobs: int = 1, progress: bool = True) -> dict:
+def run(path, runner, jobs: int = 1, progress: bool = True, engine=None) -> dict:
     """Run a study file: the runs (resumable), then tables and figures under its out folder."""
     from .axes import announce
     from .sweep import Sweep
@@ -220,8 +220,7 @@ def run(path, runner, jobs: int = 1, progress: bool = True) -> dict:
     out = Path(d["out"])
     log.info("study %r: %d runs (%d seeds) in %s", d["name"], len(ps), len(d["seeds"]), out)
     announce(ps, out / "runs", d["protocol"])
-    runner.show_progress = progress and jobs == 1
-    results = Sweep(runner, out / "runs", jobs=jobs, progress=progress).run(ps)
+    results = Sweep(runner, out / "runs", jobs=jobs, progress=progress, engine=engine).run(ps)
     out.mkdir(parents=True, exist_ok=True)
     runs, summ = tables(d, results, out)
     figs = figures(d, results, out / "figures") if results else []

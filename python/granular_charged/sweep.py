@@ -1,6 +1,6 @@
 """Parameter sweeps over q, r_p, U_0, gamma (and seeds): one folder and one result.json per run,
-finished runs skipped (resumable), a progress bar with runs done/total, elapsed time and ETA,
-and one log line per finished run.
+run by the workflow engine (granular_charged.studies.engine): finished runs kept (resumable), a
+progress bar with runs done/total, elapsed time and ETA, and one log line per finished run.
 
 The paper's full set (its Figs. 2, 3a-c, 5a-c, 9, 10; N = 2000, L = 28 r_p, hours):
   granular-charged sweep --preset paper --N 2000 --seeds 1 2 3 --out paper-results --figures paper-figures
@@ -10,16 +10,12 @@ from __future__ import annotations
 
 import itertools
 import logging
-import time
-from concurrent.futures import ThreadPoolExecutor, as_completed
 from pathlib import Path
 from types import MappingProxyType
 
-from tqdm import tqdm
-from tqdm.contrib.logging import logging_redirect_tqdm
-
+from .studies.engine import Engine, deposition_cases
 from .params import DepositionParams
-from .runner import RunError, Runner, load_result_files
+from .runner import Runner, load_result_files, read_result
 
 log = logging.getLogger(__name__)
 
@@ -51,105 +47,46 @@ def expand(sets, N, seeds, extra, fields=None) -> list[DepositionParams]:
 
 
 class Sweep:
-    """Runs a list of depositions into ``out`` (one folder each), resumably."""
+    """Runs a list of depositions into ``out`` (one folder each) through the workflow engine
+    (engine.Engine: locally ``jobs`` at a time, or on a cluster); finished runs are kept."""
 
     def __init__(self, runner: Runner, out: Path, jobs: int = 1, keep_going: bool = True,
-                 progress: bool = True):
+                 progress: bool = True, engine: Engine | None = None):
         self.runner = runner
         self.out = Path(out)
-        self.jobs = max(1, jobs)
-        self.keep_going = keep_going
-        self.progress = progress
+        self.engine = engine or Engine(jobs=max(1, jobs), progress=progress)
+        self.engine.keep_going = keep_going
 
-    def run(self, params: list[DepositionParams], tracer=0, on_result=None) -> list[dict]:
+    def run(self, params: list[DepositionParams], tracer=0) -> list[dict]:
         """Run every parameter set not finished before; return all results (finished before
         and new) in the order of params, failed runs left out (logged). ``tracer``: particle id
-        to follow, or a function of the DepositionParams giving it. ``on_result(p, result)``:
-        called in this thread for each result as soon as it is there (finished before: first)."""
-        on_result = on_result or (lambda p, r: None)
+        to follow, or a function of the DepositionParams giving it."""
         for p in params:          # every run checked before the first starts
             self.runner.check(p, tracer(p) if callable(tracer) else tracer)
-        self.out.mkdir(parents=True, exist_ok=True)
-        results: dict[int, dict] = {}
-        todo = []
-        for k, p in enumerate(params):
-            r = self.runner.finished(p, self.out)
-            if r is not None:
-                r["skipped"] = True
-                r["dir"] = str(self.runner.workdir(p, self.out))
-                results[k] = r
-                on_result(p, r)
-            else:
-                todo.append((k, p))
-        n = len(params)
-        log.info("sweep: %d runs, %d finished before (skipped), %d to run, %d at a time, "
-                 "%d MPI rank(s) each, in %s", n, n - len(todo), len(todo), self.jobs,
-                 self.runner.np_ranks, self.out)
+        cases = deposition_cases(params, "", self.runner.np_ranks, tracer, [self.out])
+        self.engine.run(self.out, cases, self.runner, describe=describe_result)
+        return finished_results(params, self.out)
 
-        def one(kp):
-            k, p = kp
-            tr = tracer(p) if callable(tracer) else tracer
-            return k, p, self.runner.deposition(p, self.out, tracer=tr)
 
-        failed = []
-        t0 = time.monotonic()
-        new_done = 0
+def finished_results(params, out: Path) -> list[dict]:
+    """The finished results of params in out/<key>/ (with 'dir'), in the order of params."""
+    results = []
+    for p in params:
+        wd = Path(out) / p.key()
+        r = read_result(wd / "result.json")
+        if r is not None:
+            r["dir"] = str(wd)
+            results.append(r)
+    return results
 
-        def eta() -> str:
-            # runs done/total, elapsed, ETA from the mean time of this session's runs
-            el = time.monotonic() - t0
-            left = len(todo) - new_done
-            rem = el / new_done * left if new_done else float("nan")
-            return (f"[{n - left}/{n} runs, elapsed {tqdm.format_interval(el)}, ETA "
-                    f"{tqdm.format_interval(rem) if new_done else '?'}]")
 
-        # tqdm: runs done/total, elapsed and ETA; finished-before runs are the bar's initial
-        # count, so they do not make the rate (and the ETA) look faster than it is
-        with logging_redirect_tqdm(), tqdm(total=n, initial=n - len(todo), unit="run",
-                                           desc="sweep", disable=not self.progress or not todo,
-                                           dynamic_ncols=True) as bar:
-            def finished(k, p, r, err):
-                nonlocal new_done
-                new_done += 1
-                bar.update(1)
-                if err is not None:
-                    failed.append(str(err))
-                    log.error("run FAILED %s: %s", eta(), err)
-                    if not self.keep_going:
-                        raise err
-                    return
-                results[k] = r
-                on_result(p, r)
-                log.info("%s %s  %6.1f s  phi = %s  <Z> = %s  lost %d  flying %d", eta(),
-                         p.key(), r["wall_s"], fmt(r["phi"], ".4f"), fmt(r["Z"], ".3f"),
-                         r["lost"], r["flying"])
-
-            if self.jobs == 1:
-                # in this thread: Ctrl-C (KeyboardInterrupt) stops the running LAMMPS child
-                # (subprocess.run kills it) and leaves its folder without result.json
-                for kp in todo:
-                    try:
-                        done = one(kp)
-                    except RunError as e:
-                        finished(*kp, None, e)
-                        continue
-                    finished(*done, None)
-            else:
-                ex = ThreadPoolExecutor(self.jobs)
-                try:
-                    futs = {ex.submit(one, kp): kp for kp in todo}
-                    for f in as_completed(futs):
-                        try:
-                            done = f.result()
-                        except RunError as e:
-                            finished(*futs[f], None, e)
-                            continue
-                        finished(*done, None)
-                finally:
-                    ex.shutdown(wait=True, cancel_futures=True)
-        if failed:
-            log.warning("sweep: %d of %d runs failed", len(failed), n)
-        return [results[k] for k in sorted(results)]
+def describe_result(path: Path) -> str | None:
+    """The log line of a finished run: its key, time, phi, <Z>, lost and flying particles."""
+    r = read_result(path)
+    if r is None:
+        return None
+    return (f"{r['key']}  {r['wall_s']:6.1f} s  phi = {fmt(r['phi'], '.4f')}  <Z> = "
+            f"{fmt(r['Z'], '.3f')}  lost {r['lost']}  flying {r['flying']}")
 
 
 def fmt(v, spec: str) -> str:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import numpy as np
+from scipy.stats import bootstrap
 import pandas as pd
 
 from . import paper
@@ -152,10 +153,15 @@ def expansion_fit(runs: pd.DataFrame, series=(2.0, 1.0, 10.0), n_boot: int = 200
         return float(np.polyfit(np.log10(q[keep]), np.log10(e[keep]), 1)[0])
 
     slope = fit({q: v.mean() for q, v in by_q.items()})
-    rng = np.random.default_rng(seed)
-    boots = np.array([b for b in (fit({q: rng.choice(v, size=len(v), replace=True).mean()
-                                       for q, v in by_q.items()}) for _ in range(n_boot))
-                      if np.isfinite(b)])
+    qs = list(by_q)
+    # every charge's seeds redrawn on their own (scipy's multi-sample bootstrap); the
+    # distribution itself, since a redraw without two positive expansions has no slope (NaN)
+    redrawn = bootstrap(tuple(by_q[q] for q in qs),
+                        lambda *v: fit({q: x.mean() for q, x in zip(qs, v)}),
+                        n_resamples=n_boot, vectorized=False, method="percentile",
+                        random_state=np.random.default_rng(seed))
+    boots = redrawn.bootstrap_distribution
+    boots = boots[np.isfinite(boots)]
     return dict(base, resolved=True, slope=slope, boot_mean=float(boots.mean()),
                 sd=float(boots.std(ddof=1)), p16=float(np.percentile(boots, 16)),
                 p84=float(np.percentile(boots, 84)))

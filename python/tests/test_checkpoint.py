@@ -155,3 +155,43 @@ def test_a_kept_restart_point_goes_on_in_another_folder(cli, build_dir, tmp_path
     assert pieces[0]["interrupted"] and pieces[0]["wall_s"] > 0
 
     assert keep_runs.keep_points(other, kept) == 0 and not kept_run.exists()
+
+
+@pytest.mark.parametrize("damage", ["truncated", "empty"])
+def test_an_unreadable_restart_point_starts_the_run_afresh(cli, build_dir, tmp_path, damage):
+    """A restart file cut short or emptied (a full disk, a copy that stopped): the deck keeps
+    only the last point, so the run starts afresh, says so in its log and in result.json, and
+    ends as a run without restart points does."""
+    ref = tmp_path / "ref"
+    cli(["-q", "run", "--out", ref, *PLANE], cwd=tmp_path)
+    cut = tmp_path / "cut"
+    _kill_after_a_point(build_dir, PLANE, cut, tmp_path)
+    wd = _run_dir(cut)
+    restart = wd / f"checkpoint-{_restart_particle(wd)}.restart"
+    data = restart.read_bytes()
+    restart.write_bytes(data[: len(data) // 2] if damage == "truncated" else b"")
+
+    r = cli(["run", "--out", cut, "--checkpoint", 5, *PLANE], cwd=tmp_path)
+    assert "could not be read; the run started afresh" in r.stderr
+    assert "Traceback" not in r.stderr
+    res = json.loads((wd / "result.json").read_text())
+    assert "could not be read; the run started afresh" in res["restart_note"]
+    assert "could not be read" in res["warning"]
+    assert (wd / "final.dump").read_bytes() == (_run_dir(ref) / "final.dump").read_bytes()
+
+
+def test_an_unreadable_pieces_file_keeps_the_earlier_cpu_time(cli, build_dir, tmp_path):
+    """pieces.json spoilt while a run was interrupted: the earlier work still counts (one
+    interrupted piece from the folder's first file to the restart point), and result.json
+    says why."""
+    cut = tmp_path / "cut"
+    _kill_after_a_point(build_dir, PLANE, cut, tmp_path)
+    wd = _run_dir(cut)
+    (wd / "pieces.json").write_text('[{"from_particle": 0, "sta')
+    cli(["-q", "run", "--out", cut, "--checkpoint", 5, *PLANE], cwd=tmp_path)
+    res = json.loads((wd / "result.json").read_text())
+    first, last = res["pieces"]
+    assert first["interrupted"] and "pieces.json was unreadable" in first["note"]
+    assert first["cpu_s"] > 0
+    assert res["cpu_s"] == pytest.approx(first["cpu_s"] + last["cpu_s"])
+    assert "pieces.json was unreadable" in res["warning"]

@@ -1,4 +1,4 @@
-"""What the command line refuses before it starts LAMMPS (issue 28, items 3 and 6), the result
+"""What the command line refuses before it starts LAMMPS, the result
 files it will not use, the summary's run count, the folder lock, and the package's import graph.
 
 None of these needs a LAMMPS build: the command line runs with GC_BUILD_DIR naming a folder
@@ -127,11 +127,11 @@ def test_deck_variables_come_from_the_deck_file(monkeypatch):
     (["run", "--N", "-5"], ["argument --N: must be >= 1, not -5"]),
     (["sweep", "--out", "r", "--N", "0"], ["argument --N: must be >= 1"]),
     (["run", "--np", "0"], ["argument --np: must be >= 1, not 0"]),
-    (["sweep", "--out", "r", "--jobs", "0"], ["argument --jobs: must be >= 1"]),
+    (["sweep", "--out", "r", "--jobs", "0"], ["argument --jobs/--cores: must be >= 1"]),
     (["demo", "--np", "0"], ["argument --np: must be >= 1"]),
     (["run", "--seed", "0"], ["argument --seed: must be >= 1"]),
     (["run", "--N", "5", "--tracer", "9"], ["tracer = 9: must be a particle id 1..N = 5"]),
-    (["run", "--U0", "0"], ["U0 = 0: must be > 0"]),
+    (["run", "--U0", "0"], ["U0 = 0: must be finite and > 0"]),
 ])
 def test_bad_values_refused_before_lammps(tmp_path, args, words):
     # before: --N 0 ran LAMMPS, then a traceback and no result.json; --np 0 ran serial

@@ -19,6 +19,7 @@ asserted): at test sizes its effect is within the seed-to-seed scatter.
 import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -53,9 +54,11 @@ def study(cli, build_dir, tmp_path_factory):
     out = tmp_path_factory.mktemp("reproduce")
     runs = out / "runs"
     # 1. start, and interrupt (SIGINT = Ctrl-C) while the second (charged) deposition runs
+    # SIGINT as at a terminal, also when the tests run in the background (which ignores it)
     p = subprocess.Popen([sys.executable, "-m", "granular_charged", *map(str, ARGS), "--out", out],
                          cwd=out, env=_env(build_dir), stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True)
+                         stderr=subprocess.PIPE, text=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     t0 = time.monotonic()
     first = second = None
     while time.monotonic() - t0 < 120 and p.poll() is None:
@@ -89,15 +92,17 @@ def test_interrupted_sweep_resumes(study):
     assert "interrupted" in study["interrupted_err"]
     # the finished run was not run again, the interrupted one was run from scratch
     assert study["first"].stat().st_mtime_ns == study["first_mtime"]
-    assert "2 runs, 1 finished before (skipped), 1 to run" in study["stderr"]
+    # the two depositions and the Table 2 check: the first deposition (and the check when it
+    # came before the interrupted run) finished before
+    assert re.search(r"3 cases, [12] finished before, [12] to run", study["stderr"]), study["stderr"]
     assert "incomplete run folder (interrupted?), running it again" in study["stderr"]
     assert (study["second"] / "result.json").exists()
     assert len(results(study)) == 2
 
 
 def test_progress_lines_have_counts_elapsed_eta(study):
-    line = [ln for ln in study["stderr"].splitlines() if "runs, elapsed" in ln]
-    assert line and line[-1].startswith("[2/2 runs, elapsed 00:") and "ETA 00:00]" in line[-1]
+    line = [ln for ln in study["stderr"].splitlines() if "cases, elapsed" in ln]
+    assert line and line[-1].startswith("[3/3 cases, elapsed 00:") and "ETA 00:00]" in line[-1]
 
 
 def test_results_json_is_what_lammps_returned(study):

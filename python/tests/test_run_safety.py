@@ -1,5 +1,4 @@
-"""Runs through LAMMPS that the checks of test_cli_checks.py cannot show (issue 28, items 3
-and 6): a material --var reaches params and the deck together; two commands running one run
+"""Runs through LAMMPS that the checks of test_cli_checks.py cannot show: a material --var reaches params and the deck together; two commands running one run
 into one folder at once; the LAMMPS child after its runner is killed with SIGKILL.
 
 Size: 5 particles in L = 6 r_p from H = 30 r_p (~1-2 s per run here). The runs that must last
