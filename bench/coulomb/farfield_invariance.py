@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Translation invariance and energy conservation of `fix coul/fmm` with each far field
-(doc/fix_coul_fmm.md, "Far field": `average` and `none` depend on where the cell's faces are).
+(doc/fix_coul_fmm.rst, "Far field": `average` and `none` depend on where the cell's faces are).
 
 1. Jump at a face: 300 charges (neutral +-1, or net-charged 1.1 / -0.9) at random in a 20 x 20 x 40 Angstrom box,
    boundary p p f, units real. The atom closest to the x = 0 face is moved by 0.02 A across it

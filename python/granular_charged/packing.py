@@ -196,7 +196,7 @@ def pair_distances(snap: Snapshot, rcut: float):
 
 def contacts(snap: Snapshot, tol: float = 0.0):
     """Geometric contacts, the definition of LAMMPS ``compute coord/dist contact geometric``
-    (doc/compute_coord_dist.md): r_ij <= r_i + r_j + tol (tol = 0: touching or overlapping, the
+    (doc/compute_coord_dist.rst): r_ij <= r_i + r_j + tol (tol = 0: touching or overlapping, the
     paper's 'geometrical contact'). Returns (pairs, overlaps delta = r_i + r_j - r_ij)."""
     rad = snap["radius"]
     pairs, dist = pair_distances(snap, 2.0 * rad.max() + tol)

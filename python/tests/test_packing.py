@@ -65,7 +65,7 @@ def bcc(n, a, r):
 def test_fz_keeps_Z_above_zmax_in_last_bin():
     # BCC of touching spheres (r = a sqrt(3)/4) with a tolerance that also reaches the 6 second
     # neighbours at distance a (third ones at a sqrt(2) stay out): Z = 14 inside, more than the
-    # 12 the old Python f(Z) had bins for. compute coord/dist (doc/compute_coord_dist.md)
+    # 12 the old Python f(Z) had bins for. compute coord/dist (doc/compute_coord_dist.rst)
     # counts Z >= zmax in its last row and has zmax = 20 by default; so must Python.
     a = 1.0
     r = a * math.sqrt(3) / 4

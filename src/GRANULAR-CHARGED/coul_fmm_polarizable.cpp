@@ -47,7 +47,7 @@ CoulFMMPolarizable::CoulFMMPolarizable(LAMMPS *lmp, const Settings &settings, co
 CoulFMMPolarizable::~CoulFMMPolarizable() = default;
 
 /* ----------------------------------------------------------------------
-   doc/fix_coul_fmm.md, "Applied field, induced dipoles, electrode": every step, replicated
+   doc/fix_coul_fmm.rst, "Applied field, induced dipoles, electrode": every step, replicated
 ------------------------------------------------------------------------- */
 
 void CoulFMMPolarizable::init()

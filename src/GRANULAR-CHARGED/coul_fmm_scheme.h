@@ -41,7 +41,7 @@ class CoulFMMScheme {
   };
 
   // the solver's side of the last evaluation (the same on every rank): vector elements 1-4,
-  // 11-14 of doc/fix_coul_fmm.md, "Output"
+  // 11-14 of doc/fix_coul_fmm.rst, "Output"
   struct Diagnostics {
     double estimated_error = 0.0, theta = 0.0;
     int order = 0, leaf = 0;

@@ -25,7 +25,7 @@ struct Options;
 namespace LAMMPS_NS {
 
 // fix coul/fmm with fix sleep/gran: the sleeping charges as a static source
-// (doc/fix_coul_fmm.md, "Sleeping particles"). Their field at the awake atoms comes from a
+// (doc/fix_coul_fmm.rst, "Sleeping particles"). Their field at the awake atoms comes from a
 // gcfmm::StaticSourceField built once per change of the sleeping set; the awake charges go
 // through the fix's Solver as before. Gathers the sleepers of all ranks sorted by atom ID (the
 // same set and order on every rank), and splits the awake targets among the ranks.

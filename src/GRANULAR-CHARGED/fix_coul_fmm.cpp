@@ -353,7 +353,7 @@ double FixCoulFMM::compute_scalar()
   return scheme->total_energy(energy_all);
 }
 
-// doc/fix_coul_fmm.md, "Output": 1-4 solver (error estimate, order, M2L, P2P), 5-7 keyword
+// doc/fix_coul_fmm.rst, "Output": 1-4 solver (error estimate, order, M2L, P2P), 5-7 keyword
 // check (last, largest, all checks), 8 interval, 9 the MTS error at the last evaluation that
 // continued a field, 10 evaluations, 11 bytes received by the busiest rank in the last
 // evaluation, 12 the largest solver memory of a rank (bytes), 13-14 the induced dipoles

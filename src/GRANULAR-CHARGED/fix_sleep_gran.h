@@ -22,7 +22,7 @@ FixStyle(sleep/gran,FixSleepGran);
 
 namespace LAMMPS_NS {
 
-// Sleeping particles for granular beds (doc/fix_sleep_gran.md): a particle of the group that has
+// Sleeping particles for granular beds (doc/fix_sleep_gran.rst): a particle of the group that has
 // been at rest (speed, surface spin speed and net force below thresholds) for a stated time, and
 // optionally lies deep enough below the local bed surface, sleeps: velocity, spin, force and
 // torque are held at zero, so the integrator leaves it in place. A sleeper wakes, with the

@@ -26,7 +26,7 @@ namespace LAMMPS_NS {
 // sub-model set (marshall_fused_set.h): one pass over the local atoms through the inline
 // equations of marshall_kernels.h, no virtual calls. Every other wall (wiggle, shear, other
 // models, heat, rigid bodies, the contacts output) runs FixWallGran::post_force(). Same
-// arguments, history layout, restart data and results as wall/gran (doc/fix_wall_gran_opt.md).
+// arguments, history layout, restart data and results as wall/gran (doc/fix_wall_gran_opt.rst).
 class FixWallGranOpt : public FixWallGran {
  public:
   FixWallGranOpt(class LAMMPS *, int, char **);

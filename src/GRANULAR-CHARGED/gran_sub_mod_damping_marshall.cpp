@@ -54,7 +54,7 @@ void GranSubModDampingMarshall::init()
    (doc/theory.md, eqs. (1.5)-(1.6); marshall_kernels.h: damping_prefactor). mass_factor 2
    (marshall) makes the Tsuji fit alpha(e) deliver e for a Hertz collision; 1
    (marshall/printed) is the form printed in the paper's eq. 2 and in LAMMPS's tsuji, which
-   rebounds with more than e (figures in doc/pair_granular_jkr_marshall.md).
+   rebounds with more than e (figures in doc/pair_granular_jkr_marshall.rst).
 ------------------------------------------------------------------------- */
 
 double GranSubModDampingMarshall::calculate_forces()

@@ -30,7 +30,7 @@ namespace LAMMPS_NS {
 // twisting marshall/jkr): one pass per neighbor pair through the inline equations of
 // marshall_kernels.h, no virtual calls. Every other type pair runs PairGranular::compute on a
 // list of those pairs only. Same pair_coeff syntax, history layout, restart and single() as granular
-// (doc/pair_granular_jkr_marshall.md, "pair_style granular/opt").
+// (doc/pair_granular_jkr_marshall.rst, "pair_style granular/opt").
 class PairGranularOpt : public PairGranular {
  public:
   PairGranularOpt(class LAMMPS *);

@@ -456,7 +456,7 @@ TEST(CoulFMMPolarize, MinimizeUsesTheCurrentPositions)
 }
 
 // the time stepping across a restart: the restarted fix evaluates at its setup (the far part's
-// trend and the dipoles are not in the file, doc/fix_coul_fmm.md) and so on other steps than
+// trend and the dipoles are not in the file, doc/fix_coul_fmm.rst) and so on other steps than
 // the uninterrupted run, but both follow the every-step run to the requested tolerance; the
 // adapted settings come back from the file (`every`, `tolerance` and `near` of the new fix)
 TEST(CoulFMMPolarize, RestartWithTimeStepping)

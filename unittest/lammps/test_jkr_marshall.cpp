@@ -326,7 +326,7 @@ TEST(JKRMarshall, RestitutionAndCapture)
   for (double e : {0.3, 0.7, 0.9}) EXPECT_NEAR(collide(e, 5.0, 0.0, 2e-11).e_apparent / e, 1.0, 2e-3);
   // the printed form sqrt(m* k_N) (damping marshall/printed) damps by 1/sqrt 2 less: the damped
   // Hertz oscillator then rebounds with 0.440 (e = 0.3) and 0.778 (e = 0.7), values integrated
-  // independently (doc/pair_granular_jkr_marshall.md); 0.3% covers the time step
+  // independently (doc/pair_granular_jkr_marshall.rst); 0.3% covers the time step
   EXPECT_NEAR(collide(0.3, 5.0, 0.0, 2e-11, "off", "marshall/printed").e_apparent, 0.440, 0.003 * 0.440);
   EXPECT_NEAR(collide(0.7, 5.0, 0.0, 2e-11, "off", "marshall/printed").e_apparent, 0.778, 0.003 * 0.778);
   EXPECT_TRUE(collide(0.7, 0.05).stuck);

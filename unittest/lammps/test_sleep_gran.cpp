@@ -294,7 +294,7 @@ TEST(FixSleepGran, CoulombSleepersAreAStaticSource)
     // nearest pairs, summed directly, dominate every force, so the test guards the split's
     // bookkeeping (the sleepers' field at the right atoms: 0.96 when it was not, 0.96 without
     // the static field); its accuracy with multipole translations is fmm.static_field's
-    // (SplitPlusStaticEqualsWholeSolver) and the deposition's check (doc/fix_coul_fmm.md)
+    // (SplitPlusStaticEqualsWholeSolver) and the deposition's check (doc/fix_coul_fmm.rst)
     const double err = rel_rms(f, fref);
     std::printf("[ static sleepers, %s ] accuracy %g: force error %.3g, energy error %.3g\n", solver,
                 acc, err, std::abs(l.var("f_coul") / eref - 1.0));

@@ -1,7 +1,7 @@
 /* GRANULAR-CHARGED: which sleepers fix sleep/gran wakes, on any processor grid, and its counts
    straight after read_restart.
 
-   The documented rule (doc/fix_sleep_gran.md, "Waking"): a sleeper whose awake partners push
+   The documented rule (doc/fix_sleep_gran.rst, "Waking"): a sleeper whose awake partners push
    it with more than `wake` wakes on that step, and so do the sleepers touching it; nothing else
    wakes. The sum over the partners may change its order with the grid, nothing else may.
 
