@@ -1,4 +1,4 @@
-// Robustness of the solver at the edges of the input range (issue 11): any length scale at
+// Robustness of the solver at the edges of the input range: any length scale at
 // high order, and particles that nearly coincide.
 #include <gtest/gtest.h>
 
