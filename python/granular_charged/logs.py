@@ -6,6 +6,20 @@ from __future__ import annotations
 
 import logging
 import sys
+from pathlib import Path
+
+
+def read_new_lines(path: Path, pos: int) -> tuple[list[str], int]:
+    """The complete lines a growing log (LAMMPS's, Snakemake's) has gained since byte pos, and
+    the position after them: a line still being written waits for the next call."""
+    try:
+        with open(path, "rb") as fh:
+            fh.seek(pos)
+            chunk = fh.read()
+    except OSError:
+        return [], pos
+    end = chunk.rfind(b"\n") + 1
+    return chunk[:end].decode(errors="replace").splitlines(), pos + end
 
 
 def setup_logging(verbose: int = 0, quiet: int = 0):

@@ -29,6 +29,7 @@ from pathlib import Path
 from . import packing, population
 from .deckfile import deck_path, deck_variables
 from .lammps_build import LammpsBuild
+from .logs import read_new_lines
 from .params import DepositionParams, ParamError, coulomb_to_adhesion
 
 log = logging.getLogger(__name__)
@@ -356,15 +357,9 @@ class Runner:
     @staticmethod
     def _progress(logf: Path, pos: int, bar) -> int:
         """Read log.lammps from byte pos; move the bar to the last GC PROGRESS line's count."""
-        try:
-            with open(logf, "rb") as fh:
-                fh.seek(pos)
-                chunk = fh.read()
-        except OSError:
-            return pos
-        end = chunk.rfind(b"\n") + 1
+        lines, pos = read_new_lines(logf, pos)
         last = settle = None
-        for line in chunk[:end].decode(errors="replace").splitlines():
+        for line in lines:
             if line.startswith("GC PROGRESS "):
                 last = parse_progress(line)
             elif line.startswith("GC SETTLE "):
@@ -382,7 +377,7 @@ class Runner:
                              "moving": settle[-1]}, refresh=False)
         if last is not None or settle is not None:
             bar.refresh()
-        return pos + end
+        return pos
 
     # ---- one deposition -------------------------------------------------------------------
     def workdir(self, p: DepositionParams, root: Path) -> Path:

@@ -9,16 +9,15 @@
 
 #include "pair_granular_opt.h"
 
-
 #include "atom.h"
 #include "comm.h"
 #include "error.h"
 #include "fix.h"
 #include "fix_neigh_history.h"
 #include "force.h"
-#include "kspace.h"
 #include "gran_sub_mod.h"
 #include "granular_model.h"
+#include "kspace.h"
 #include "math_extra.h"
 #include "memory.h"
 #include "modify.h"

@@ -285,17 +285,11 @@ def progress(new_done: int, todo: int, total: int, elapsed: float) -> str:
 
 def _relay(logfile: Path, pos: int) -> int:
     """Relay the cases' marked log lines written to Snakemake's log since byte pos."""
-    from ..logs import relay_case_line
-    try:
-        with open(logfile, "rb") as fh:
-            fh.seek(pos)
-            chunk = fh.read()
-    except OSError:
-        return pos
-    end = chunk.rfind(b"\n") + 1
-    for line in chunk[:end].decode(errors="replace").splitlines():
+    from ..logs import read_new_lines, relay_case_line
+    lines, pos = read_new_lines(logfile, pos)
+    for line in lines:
         relay_case_line(line, log)
-    return pos + end
+    return pos
 
 
 def _signal_group(pid: int, sig):
