@@ -39,6 +39,8 @@ class CoulFMMNearRefresh : protected Pointers {
   // group into now() (trend >= 0: between evaluations) or then() (trend < 0: the D of a slope)
   void compute(const CoulFMMTimeStepping &scheme, const class CoulFMMState &state, bool into_then,
                double trend);
+  // the evaluation state changed (an evaluation, a new run): the held pairs are taken afresh
+  void forget_pairs() { held_valid = false; }
   double **now() const { return near_now; }
   double **then() const { return near_then; }
 
@@ -60,6 +62,30 @@ class CoulFMMNearRefresh : protected Pointers {
   std::vector<std::pair<int, int>> pair_i;      // each first atom and the end of its pairs
   gcsimd::SimdPath simd_path;
   void grow_pairs(int n);
+  void exchange_displacements(const class CoulFMMState &state);
+  void compute_all(const CoulFMMTimeStepping &scheme, double trend, double **out);
+
+  // Between evaluations a pair's separation at the evaluation, now - (Delta_i - Delta_j), does
+  // not change while the atoms do not wrap (only when the lists are built), nor does the change
+  // its slope carries: they are taken once per list build and evaluation (held), and each step
+  // only the separation now is computed, without the displacements or their communication.
+  struct HeldPair {
+    int j;
+    double r2then;                 // squared separation at the evaluation
+    double terms_then[4];          // (K, 1/r) at the evaluation
+    double slope_change[4];        // CoulFMMTimeStepping::slope_pair_change
+  };
+  std::vector<HeldPair> held;
+  std::vector<std::pair<int, int>> held_i;      // each first atom and the end of its pairs
+  // what the held pairs belong to: the neighbor build (count and step), the evaluation state
+  // (forget_pairs) and the box (atoms unmap with it)
+  bool held_valid;
+  bigint held_ncalls, held_lastcall;
+  double held_box[9];
+  void box_now(double box[9]) const;
+  bool holds_current() const;
+  void hold_pairs(const CoulFMMTimeStepping &scheme, const class CoulFMMState &state);
+  void compute_held(const CoulFMMTimeStepping &scheme, double trend, double **out);
 };
 
 }    // namespace LAMMPS_NS

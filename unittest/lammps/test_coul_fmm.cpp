@@ -761,6 +761,32 @@ TEST(CoulFMM, NearRefreshAndCheck)
   EXPECT_GE(frozen[1], frozen[0]);    // checks at steps 5, 10, 15: the error grows
 }
 
+// the near refresh holds each pair's separation at the evaluation (and the change its slope
+// carries) from one neighbor list build or evaluation to the next, instead of taking it afresh
+// from the displacements every step: a run that builds the lists every step (so the pairs are
+// taken afresh every step) must give the same forces and positions to round-off. every 8 with a
+// slope (trend > 0 after step 16), about 6 list builds of their own in the other run, atoms
+// crossing the periodic sides. A held pair kept over an evaluation, or over a list build, is
+// off by the change of its field in between (~1e-4 of the force here).
+TEST(CoulFMM, NearRefreshHeldPairsAsTakenEveryStep)
+{
+  auto run = [](const std::string &check) {
+    Lmp l;
+    moving_charges(l);
+    l.cmds({"mass 1 200.0", "neigh_modify every 1 delay 0 check " + check,
+            "fix fmm all coul/fmm accuracy 1e-8 every 8 near 5.0", "run 60 post no"});
+    auto f = gather(l, "f", 3);
+    l.cmds({"run 0 post no"});    // wraps both alike
+    return std::make_pair(f, gather(l, "x", 3));
+  };
+  const auto [f_held, x_held] = run("yes");
+  const auto [f_each, x_each] = run("no");
+  std::printf("[ near held ] forces %.3g, positions %.3g apart\n", rel_rms(f_held, f_each),
+              rel_rms(x_held, x_each));
+  EXPECT_LT(rel_rms(f_held, f_each), 1e-11);
+  EXPECT_LT(rel_rms(x_held, x_each), 1e-13);
+}
+
 // extrapolation of the far part: on nearly straight trajectories (heavy charges) the far part
 // of the field changes nearly linearly between evaluations, so the slope of the last two
 // evaluations removes most of the error of a frozen field; the close pairs, whose field is not
