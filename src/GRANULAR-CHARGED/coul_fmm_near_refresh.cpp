@@ -226,28 +226,33 @@ void CoulFMMNearRefresh::hold_pairs(const MTS &scheme, const CoulFMMState &state
   box_now(held_box);
 }
 
-// between evaluations: per held pair only the separation now and its terms; dg = (K, 1/r)(now)
-// - (K, 1/r)(then) - trend (slope change), summed in the list's order as compute_all does
+// between evaluations: per held pair only the separation now and its terms (all of them in one
+// call, SIMD); dg = (K, 1/r)(now) - (K, 1/r)(then) - trend (slope change), summed in the list's
+// order as compute_all does
 void CoulFMMNearRefresh::compute_held(const MTS &scheme, double trend, double **out)
 {
   const int nlocal = atom->nlocal;
   double **x = atom->x, *q = atom->q;
+  grow_pairs((int) held.size());
   std::size_t p = 0;
   for (const auto &[i, end] : held_i) {
     const double xi[3] = {x[i][0], x[i][1], x[i][2]};
+    for (; p < (std::size_t) end; p++) {
+      const double *xj = x[held[p].j];
+      for (int k = 0; k < 3; k++) pair_now[k][p] = xi[k] - xj[k];
+    }
+  }
+  gcfmm::charge_terms_at(held.size(), {pair_now[0], pair_now[1], pair_now[2]},
+                         {pair_dg[0], pair_dg[1], pair_dg[2], pair_dg[3], pair_r2now}, simd_path);
+  p = 0;
+  for (const auto &[i, end] : held_i) {
     double e[4] = {0.0, 0.0, 0.0, 0.0};
     for (; p < (std::size_t) end; p++) {
       const HeldPair &h = held[p];
+      if (!scheme.near_pair_refreshed(pair_r2now[p], h.r2then, true)) continue;
       const int j = h.j;
-      const double now[3] = {xi[0] - x[j][0], xi[1] - x[j][1], xi[2] - x[j][2]};
-      const double r2now = now[0] * now[0] + now[1] * now[1] + now[2] * now[2];
-      if (!scheme.near_pair_refreshed(r2now, h.r2then, true)) continue;
-      gcfmm::FieldTerms<double> t;
-      gcfmm::charge_terms<false>(1.0, now[0], now[1], now[2], 1.0 / std::sqrt(r2now), t);
-      const double dg[4] = {t.ex - h.terms_then[0] - trend * h.slope_change[0],
-                            t.ey - h.terms_then[1] - trend * h.slope_change[1],
-                            t.ez - h.terms_then[2] - trend * h.slope_change[2],
-                            t.pot - h.terms_then[3] - trend * h.slope_change[3]};
+      double dg[4];
+      for (int k = 0; k < 4; k++) dg[k] = pair_dg[k][p] - h.terms_then[k] - trend * h.slope_change[k];
       for (int k = 0; k < 4; k++) e[k] += q[j] * dg[k];
       if (j < nlocal) {
         for (int k = 0; k < 3; k++) out[j][k] -= q[i] * dg[k];

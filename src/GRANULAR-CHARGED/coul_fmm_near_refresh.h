@@ -56,6 +56,7 @@ class CoulFMMNearRefresh : protected Pointers {
   int nmax_delta, nmax_out;
   // the pairs of one compute() as arrays (gcfmm::charge_pair_change): separations now and at
   // the evaluation, the kernel differences and the squared separations, in pair_buffer
+  // (compute_held: the separations now, their terms (gcfmm::charge_terms_at) in pair_dg)
   std::vector<double> pair_buffer;
   double *pair_now[3], *pair_then[3], *pair_dg[4], *pair_r2now, *pair_r2then;
   std::vector<int> pair_j;                      // the pairs' second atoms
