@@ -772,6 +772,10 @@ TEST(CoulFMM, NearRefreshAndCheck)
 // build, is off by the change of its field in between (~0.7 of the force here).
 TEST(CoulFMM, NearRefreshHeldPairsAsTakenEveryStep)
 {
+  // on two ranks these two runs differ by 1.1e-4 also with the pairs taken afresh every step
+  // (every 8 as well; 5e-14 at every 2): there the refreshed sum depends on when lists are
+  // built, which is not what this test is about
+  if (nprocs() != 1) GTEST_SKIP() << "one rank only";
   auto run = [](const std::string &check) {
     Lmp l;
     moving_charges(l, "p p f");
