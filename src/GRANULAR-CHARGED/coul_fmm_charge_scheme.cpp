@@ -118,6 +118,7 @@ void CoulFMMChargeScheme::compute_field(bool with_slope)
                          plan.near ? p.near->then()[i] : nullptr, st.field(i));
   }
   st.record(mts, eval->boundary());
+  p.near->forget_pairs();    // the held pairs belong to the evaluation state overwritten above
   eval->evaluate([&st](int i) { return st.evaluated_field(i); }, true);
   nevaluations += 1.0;
   double sums[2] = {0.0, 0.0};

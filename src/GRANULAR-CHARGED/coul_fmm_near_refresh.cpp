@@ -14,6 +14,7 @@
 #include "coul_fmm_time_stepping.h"
 
 #include "gcfmm/charge_pair_change.hpp"
+#include "gcfmm/dipole_kernels.hpp"
 
 #include "atom.h"
 #include "comm.h"
@@ -26,6 +27,7 @@
 #include "neighbor.h"
 
 #include <algorithm>
+#include <cmath>
 
 using namespace LAMMPS_NS;
 using MTS = CoulFMMTimeStepping;
@@ -33,7 +35,8 @@ using MTS = CoulFMMTimeStepping;
 CoulFMMNearRefresh::CoulFMMNearRefresh(LAMMPS *lmp, Fix *owner) :
     Pointers(lmp), fix(owner), list(nullptr), delta(nullptr), near_now(nullptr), near_then(nullptr),
     nmax_delta(0), nmax_out(0), pair_now{}, pair_then{}, pair_dg{}, pair_r2now(nullptr),
-    pair_r2then(nullptr), simd_path(gcsimd::default_simd_path())
+    pair_r2then(nullptr), simd_path(gcsimd::default_simd_path()), held_valid(false),
+    held_ncalls(-1), held_lastcall(-1), held_box{}
 {
 }
 
@@ -60,7 +63,7 @@ void CoulFMMNearRefresh::request(double cutoff)
 void CoulFMMNearRefresh::compute(const MTS &scheme, const CoulFMMState &state, bool into_then,
                                  double trend)
 {
-  const int nlocal = atom->nlocal, nall = nlocal + atom->nghost;
+  const int nlocal = atom->nlocal;
   if (atom->nmax > nmax_out) {
     nmax_out = atom->nmax;
     memory->destroy(near_now);
@@ -68,26 +71,49 @@ void CoulFMMNearRefresh::compute(const MTS &scheme, const CoulFMMState &state, b
     memory->create(near_now, nmax_out, 4, "coul/fmm:near_now");
     memory->create(near_then, nmax_out, 4, "coul/fmm:near_then");
   }
+  double **out = into_then ? near_then : near_now;
+  for (int i = 0; i < nlocal; i++)
+    for (int k = 0; k < 4; k++) out[i][k] = 0.0;
+  if (into_then) {
+    exchange_displacements(state);
+    compute_all(scheme, trend, out);
+  } else {
+    // every rank decides alike: neighbor builds, evaluations and the box are global
+    if (!holds_current()) hold_pairs(scheme, state);
+    compute_held(scheme, trend, out);
+  }
+  const double c = force->qqrd2e;
+  for (int i = 0; i < nlocal; i++)
+    for (int k = 0; k < 4; k++) out[i][k] *= c;
+}
+
+// each atom's Delta row (local atoms from the state, ghosts by the fix's forward communication)
+void CoulFMMNearRefresh::exchange_displacements(const CoulFMMState &state)
+{
+  const int nlocal = atom->nlocal, nall = nlocal + atom->nghost;
   if (nall > nmax_delta) {
     nmax_delta = atom->nmax;
     memory->destroy(delta);
     memory->create(delta, nmax_delta, MTS::DELTA_COLS, "coul/fmm:near_delta");
   }
-  double **x = atom->x, *q = atom->q, **out = into_then ? near_then : near_now;
-  int *mask = atom->mask;
-  const int groupbit = fix->groupbit;
+  double **x = atom->x;
   double xu[3];
   for (int i = 0; i < nlocal; i++) {
     domain->unmap(x[i], atom->image[i], xu);
     MTS::displacements(xu, state.evaluation(i), delta[i]);
   }
   comm->forward_comm(fix);
-  for (int i = 0; i < nlocal; i++)
-    for (int k = 0; k < 4; k++) out[i][k] = 0.0;
+}
 
-  // the pairs of charged atoms of the group in the list's order (their j and, per i, where
-  // they end): their separations now and at the evaluation, then the kernel differences of all
-  // of them in one call (SIMD), then the sums in the same order as pair by pair
+// the pairs of charged atoms of the group in the list's order (their j and, per i, where
+// they end): their separations now and at the evaluation, then the kernel differences of all
+// of them in one call (SIMD), then the sums in the same order as pair by pair
+void CoulFMMNearRefresh::compute_all(const MTS &scheme, double trend, double **out)
+{
+  const int nlocal = atom->nlocal;
+  double **x = atom->x, *q = atom->q;
+  int *mask = atom->mask;
+  const int groupbit = fix->groupbit;
   auto charged = [&](int j) { return (mask[j] & groupbit) && q[j] != 0.0; };
   int npairs = 0;
   for (int ii = 0; ii < list->inum; ii++)
@@ -138,9 +164,103 @@ void CoulFMMNearRefresh::compute(const MTS &scheme, const CoulFMMState &state, b
     }
     for (int k = 0; k < 4; k++) out[i][k] += e[k];
   }
-  const double c = force->qqrd2e;
-  for (int i = 0; i < nlocal; i++)
-    for (int k = 0; k < 4; k++) out[i][k] *= c;
+}
+
+void CoulFMMNearRefresh::box_now(double box[9]) const
+{
+  const double now[9] = {domain->boxlo[0], domain->boxlo[1], domain->boxlo[2],
+                         domain->prd[0],   domain->prd[1],   domain->prd[2],
+                         domain->xy,       domain->xz,       domain->yz};
+  std::copy(now, now + 9, box);
+}
+
+bool CoulFMMNearRefresh::holds_current() const
+{
+  if (!held_valid || neighbor->ncalls != held_ncalls || neighbor->lastcall != held_lastcall)
+    return false;
+  double box[9];
+  box_now(box);
+  return std::equal(box, box + 9, held_box);
+}
+
+// the list's pairs of charged atoms of the group, with what stays fixed until the next list
+// build or evaluation: the separation at the evaluation (its square and terms) and the change
+// the slope carries. A pair coincident at the evaluation is never refreshed: left out.
+void CoulFMMNearRefresh::hold_pairs(const MTS &scheme, const CoulFMMState &state)
+{
+  exchange_displacements(state);
+  double **x = atom->x, *q = atom->q;
+  int *mask = atom->mask;
+  const int groupbit = fix->groupbit;
+  auto charged = [&](int j) { return (mask[j] & groupbit) && q[j] != 0.0; };
+  held.clear();
+  held_i.clear();
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    if (!charged(i)) continue;
+    for (int jj = 0; jj < list->numneigh[i]; jj++) {
+      const int j = list->firstneigh[i][jj] & NEIGHMASK;
+      if (!charged(j)) continue;
+      double now[3], then[3];
+      for (int k = 0; k < 3; k++) now[k] = x[i][k] - x[j][k];
+      MTS::separation_then(now, delta[i], delta[j], then);
+      const double r2then = then[0] * then[0] + then[1] * then[1] + then[2] * then[2];
+      if (r2then == 0.0) continue;
+      HeldPair h;
+      h.j = j;
+      h.r2then = r2then;
+      gcfmm::FieldTerms<double> t;
+      gcfmm::charge_terms<false>(1.0, then[0], then[1], then[2], 1.0 / std::sqrt(r2then), t);
+      h.terms_then[0] = t.ex;
+      h.terms_then[1] = t.ey;
+      h.terms_then[2] = t.ez;
+      h.terms_then[3] = t.pot;
+      scheme.slope_pair_change(now, delta[i], delta[j], h.slope_change);
+      held.push_back(h);
+    }
+    held_i.push_back({i, (int) held.size()});
+  }
+  held_valid = true;
+  held_ncalls = neighbor->ncalls;
+  held_lastcall = neighbor->lastcall;
+  box_now(held_box);
+}
+
+// between evaluations: per held pair only the separation now and its terms (all of them in one
+// call, SIMD); dg = (K, 1/r)(now) - (K, 1/r)(then) - trend (slope change), summed in the list's
+// order as compute_all does
+void CoulFMMNearRefresh::compute_held(const MTS &scheme, double trend, double **out)
+{
+  const int nlocal = atom->nlocal;
+  double **x = atom->x, *q = atom->q;
+  grow_pairs((int) held.size());
+  std::size_t p = 0;
+  for (const auto &[i, end] : held_i) {
+    const double xi[3] = {x[i][0], x[i][1], x[i][2]};
+    for (; p < (std::size_t) end; p++) {
+      const double *xj = x[held[p].j];
+      for (int k = 0; k < 3; k++) pair_now[k][p] = xi[k] - xj[k];
+    }
+  }
+  gcfmm::charge_terms_at(held.size(), {pair_now[0], pair_now[1], pair_now[2]},
+                         {pair_dg[0], pair_dg[1], pair_dg[2], pair_dg[3], pair_r2now}, simd_path);
+  p = 0;
+  for (const auto &[i, end] : held_i) {
+    double e[4] = {0.0, 0.0, 0.0, 0.0};
+    for (; p < (std::size_t) end; p++) {
+      const HeldPair &h = held[p];
+      if (!scheme.near_pair_refreshed(pair_r2now[p], h.r2then, true)) continue;
+      const int j = h.j;
+      double dg[4];
+      for (int k = 0; k < 4; k++) dg[k] = pair_dg[k][p] - h.terms_then[k] - trend * h.slope_change[k];
+      for (int k = 0; k < 4; k++) e[k] += q[j] * dg[k];
+      if (j < nlocal) {
+        for (int k = 0; k < 3; k++) out[j][k] -= q[i] * dg[k];
+        out[j][3] += q[i] * dg[3];
+      }
+    }
+    for (int k = 0; k < 4; k++) out[i][k] += e[k];
+  }
 }
 
 // twelve arrays of at least n (and at least one, so that the pointers are valid for n = 0);
@@ -178,5 +298,6 @@ double CoulFMMNearRefresh::memory_usage() const
 {
   return ((double) MTS::DELTA_COLS * nmax_delta + 8.0 * nmax_out + pair_buffer.size()) *
       sizeof(double) + (double) pair_j.size() * sizeof(int) +
-      (double) pair_i.capacity() * sizeof(pair_i[0]);
+      (double) pair_i.capacity() * sizeof(pair_i[0]) +
+      (double) held.capacity() * sizeof(HeldPair) + (double) held_i.capacity() * sizeof(held_i[0]);
 }

@@ -39,6 +39,8 @@ class CoulFMMNearRefresh : protected Pointers {
   // group into now() (trend >= 0: between evaluations) or then() (trend < 0: the D of a slope)
   void compute(const CoulFMMTimeStepping &scheme, const class CoulFMMState &state, bool into_then,
                double trend);
+  // the evaluation state changed (an evaluation, a new run): the held pairs are taken afresh
+  void forget_pairs() { held_valid = false; }
   double **now() const { return near_now; }
   double **then() const { return near_then; }
 
@@ -54,12 +56,37 @@ class CoulFMMNearRefresh : protected Pointers {
   int nmax_delta, nmax_out;
   // the pairs of one compute() as arrays (gcfmm::charge_pair_change): separations now and at
   // the evaluation, the kernel differences and the squared separations, in pair_buffer
+  // (compute_held: the separations now, their terms (gcfmm::charge_terms_at) in pair_dg)
   std::vector<double> pair_buffer;
   double *pair_now[3], *pair_then[3], *pair_dg[4], *pair_r2now, *pair_r2then;
   std::vector<int> pair_j;                      // the pairs' second atoms
   std::vector<std::pair<int, int>> pair_i;      // each first atom and the end of its pairs
   gcsimd::SimdPath simd_path;
   void grow_pairs(int n);
+  void exchange_displacements(const class CoulFMMState &state);
+  void compute_all(const CoulFMMTimeStepping &scheme, double trend, double **out);
+
+  // Between evaluations a pair's separation at the evaluation, now - (Delta_i - Delta_j), does
+  // not change while the atoms do not wrap (only when the lists are built), nor does the change
+  // its slope carries: they are taken once per list build and evaluation (held), and each step
+  // only the separation now is computed, without the displacements or their communication.
+  struct HeldPair {
+    int j;
+    double r2then;                 // squared separation at the evaluation
+    double terms_then[4];          // (K, 1/r) at the evaluation
+    double slope_change[4];        // CoulFMMTimeStepping::slope_pair_change
+  };
+  std::vector<HeldPair> held;
+  std::vector<std::pair<int, int>> held_i;      // each first atom and the end of its pairs
+  // what the held pairs belong to: the neighbor build (count and step), the evaluation state
+  // (forget_pairs) and the box (atoms unmap with it)
+  bool held_valid;
+  bigint held_ncalls, held_lastcall;
+  double held_box[9];
+  void box_now(double box[9]) const;
+  bool holds_current() const;
+  void hold_pairs(const CoulFMMTimeStepping &scheme, const class CoulFMMState &state);
+  void compute_held(const CoulFMMTimeStepping &scheme, double trend, double **out);
 };
 
 }    // namespace LAMMPS_NS

@@ -10,6 +10,7 @@
 #include "coul_fmm_time_stepping.h"
 
 #include "gcfmm/charge_pair_change.hpp"
+#include "gcfmm/dipole_kernels.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -175,19 +176,25 @@ bool CoulFMMTimeStepping::near_pair_change(const double now[3], const double *di
   return true;
 }
 
-void CoulFMMTimeStepping::remove_trend(const double now[3], const double rb[3], double rb2,
-                                       const double *di, const double *dj, double trend,
-                                       double dg[4]) const
+void CoulFMMTimeStepping::slope_pair_change(const double now[3], const double *di,
+                                            const double *dj, double change[4]) const
 {
-  double ra[3];
-  for (int k = 0; k < 3; k++) ra[k] = now[k] - (di[DELTA_A + k] - dj[DELTA_A + k]);
-  const double ra2 = dot(ra, ra);
-  if (ra2 > 0.0) {
-    const double ib = 1.0 / std::sqrt(rb2), ia = 1.0 / std::sqrt(ra2);
-    const double sb = trend * ib * ib * ib, sa = trend * ia * ia * ia;
-    for (int k = 0; k < 3; k++) dg[k] -= sb * rb[k] - sa * ra[k];
-    dg[3] -= trend * (ib - ia);
+  for (int k = 0; k < 4; k++) change[k] = 0.0;
+  if (di[DELTA_IN_SLOPE] == 0.0 || dj[DELTA_IN_SLOPE] == 0.0) return;
+  double rb[3], ra[3];
+  for (int k = 0; k < 3; k++) {
+    rb[k] = now[k] - (di[DELTA_B + k] - dj[DELTA_B + k]);
+    ra[k] = now[k] - (di[DELTA_A + k] - dj[DELTA_A + k]);
   }
+  const double rb2 = dot(rb, rb), ra2 = dot(ra, ra);
+  if (rb2 < set.near_cutoff * set.near_cutoff || ra2 == 0.0) return;
+  gcfmm::FieldTerms<double> b, a;
+  gcfmm::charge_terms<false>(1.0, rb[0], rb[1], rb[2], 1.0 / std::sqrt(rb2), b);
+  gcfmm::charge_terms<false>(1.0, ra[0], ra[1], ra[2], 1.0 / std::sqrt(ra2), a);
+  change[0] = b.ex - a.ex;
+  change[1] = b.ey - a.ey;
+  change[2] = b.ez - a.ez;
+  change[3] = b.pot - a.pot;
 }
 
 void CoulFMMTimeStepping::displacements(const double xu[3], const double *state, double *delta)

@@ -131,6 +131,21 @@ class CoulFMMTimeStepping {
   }
   bool near_pair_finish(const double now[3], double rn2, double rt2, const double *di,
                         const double *dj, double trend, double dg[4]) const;
+  // whether a pair at squared separations rn2 now and rt2 at the evaluation is refreshed
+  // (between: between evaluations, trend >= 0); the rule of near_pair_finish
+  bool near_pair_refreshed(double rn2, double rt2, bool between) const
+  {
+    const double cutsq = set.near_cutoff * set.near_cutoff;
+    if (rn2 >= cutsq && (!between || rt2 >= cutsq)) return false;
+    return rn2 != 0.0 && rt2 != 0.0;    // coincident atoms are caught at evaluations
+  }
+  // the change of (K, 1/r) over the slope's interval that the slope carries for this pair, per
+  // unit trend: (K, 1/r)(r_B) - (K, 1/r)(r_A) if the slope covers both atoms and the pair was
+  // beyond the cutoff at the slope's later end, else 0. Between evaluations it depends on the
+  // positions at the evaluations only (now - (di - dj) is fixed while the atoms do not wrap),
+  // so the near refresh takes it once per neighbor list and evaluation.
+  void slope_pair_change(const double now[3], const double *di, const double *dj,
+                         double change[4]) const;
   // an atom's Delta row from its unwrapped position now and its state
   static void displacements(const double xu[3], const double *state, double *delta);
 
@@ -173,11 +188,6 @@ class CoulFMMTimeStepping {
   bool read_restart(const double *list);
 
  private:
-  // near_pair_finish for a pair beyond the cutoff at the slope's later end (rb, rb2 = |rb|^2): minus trend
-  // times the pair's change over the slope's interval
-  void remove_trend(const double now[3], const double rb[3], double rb2, const double *di,
-                    const double *dj, double trend, double dg[4]) const;
-
   Settings set;
   int interval;          // evaluations on the steps that are multiples of it
   double estimate;       // error measured at the last evaluation that continued a field
@@ -210,16 +220,13 @@ inline bool CoulFMMTimeStepping::near_pair_finish(const double now[3], double rn
                                                   const double *di, const double *dj,
                                                   double trend, double dg[4]) const
 {
-  const double cutsq = set.near_cutoff * set.near_cutoff;
-  if (rn2 >= cutsq && (trend < 0.0 || rt2 >= cutsq)) return false;
-  if (rn2 == 0.0 || rt2 == 0.0) return false;    // coincident atoms are caught at evaluations
+  if (!near_pair_refreshed(rn2, rt2, trend >= 0.0)) return false;
   // a pair that was beyond the cutoff at the later evaluation of the slope has its trend in
   // the slope: take it out, the pair is summed exactly (doc/theory.md, eq. (5.3))
-  if (trend > 0.0 && di[DELTA_IN_SLOPE] != 0.0 && dj[DELTA_IN_SLOPE] != 0.0) {
-    double rb[3];
-    for (int k = 0; k < 3; k++) rb[k] = now[k] - (di[DELTA_B + k] - dj[DELTA_B + k]);
-    const double rb2 = rb[0] * rb[0] + rb[1] * rb[1] + rb[2] * rb[2];
-    if (rb2 >= cutsq) remove_trend(now, rb, rb2, di, dj, trend, dg);
+  if (trend > 0.0) {
+    double change[4];
+    slope_pair_change(now, di, dj, change);
+    for (int k = 0; k < 4; k++) dg[k] -= trend * change[k];
   }
   return true;
 }

@@ -279,6 +279,7 @@ void FixCoulFMM::init_list(int /*id*/, NeighList *ptr)
 void FixCoulFMM::setup(int vflag)
 {
   if (!scheme->continues()) stepping->restart_schedule();
+  near->forget_pairs();    // a new run: its atoms and state may have been changed in between
   if (utils::strmatch(update->integrate_style, "^verlet")) {
     post_force(vflag);
   } else {

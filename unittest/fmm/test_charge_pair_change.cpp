@@ -133,3 +133,32 @@ TEST(ChargePairChange, IsTheKernelDifference) {
     EXPECT_EQ(out.pot[5], 1.0 / std::sqrt(out.r2n[5]));     // zero then: only now's term
   }
 }
+
+// charge_terms_at, the `now` half alone (the near refresh holds the evaluation's half): on every
+// path the same bits as the scalar terms, for every tail length; a zero separation has no terms.
+TEST(ChargePairChange, TermsAtEveryPathGiveTheScalarBits) {
+  std::vector<std::size_t> counts;
+  for (std::size_t n = 0; n < 20; ++n) counts.push_back(n);
+  counts.push_back(1037);
+  const double zero[3] = {0.0, 0.0, 0.0};
+  for (gcsimd::SimdPath path : available_paths()) {
+    for (std::size_t n : counts) {
+      const Pairs p = random_pairs(n, 11 + n);
+      Out out(n);
+      charge_terms_at(n, {p.nx.data(), p.ny.data(), p.nz.data()},
+                      {out.ex.data(), out.ey.data(), out.ez.data(), out.pot.data(), out.r2n.data()}, path);
+      for (std::size_t k = 0; k < n; ++k) {
+        const double now[3] = {p.nx[k], p.ny[k], p.nz[k]};
+        double t[4];
+        scalar(now, zero, t);
+        const double got[4] = {out.ex[k], out.ey[k], out.ez[k], out.pot[k]};
+        for (int c = 0; c < 4; ++c)
+          ASSERT_TRUE(same_bits(got[c], t[c]))
+              << gcsimd::simd_path_name(path) << " n " << n << " pair " << k << " component " << c << ": " << got[c]
+              << " != " << t[c];
+        EXPECT_EQ(out.r2n[k], now[0] * now[0] + now[1] * now[1] + now[2] * now[2]);
+      }
+      if (n > 3) EXPECT_EQ(out.pot[3], 0.0);
+    }
+  }
+}

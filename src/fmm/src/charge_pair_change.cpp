@@ -43,6 +43,29 @@ GCSIMD_ALWAYS_INLINE void change_loop(std::size_t n, const double *__restrict nx
   }
 }
 
+GCSIMD_ALWAYS_INLINE void terms_loop(std::size_t n, const double *__restrict dx, const double *__restrict dy,
+                                     const double *__restrict dz, double *__restrict ex, double *__restrict ey,
+                                     double *__restrict ez, double *__restrict pot, double *__restrict r2) {
+#pragma omp simd
+  for (std::size_t k = 0; k < n; ++k) {
+    const double d2 = dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k];
+    FieldTerms<double> a;
+    charge_terms<false>(1.0, dx[k], dy[k], dz[k], inverse_distance(d2), a);
+    ex[k] = a.ex;
+    ey[k] = a.ey;
+    ez[k] = a.ez;
+    pot[k] = a.pot;
+    r2[k] = d2;
+  }
+}
+
+#define GCFMM_TERMS_PARAMS                                                                       \
+  (std::size_t n, const double *dx, const double *dy, const double *dz, double *ex, double *ey,     \
+   double *ez, double *pot, double *r2)
+#define GCFMM_TERMS_ARGS (n, dx, dy, dz, ex, ey, ez, pot, r2)
+
+GCSIMD_DEFINE_PATHS(void, terms_kernel, GCFMM_TERMS_PARAMS, terms_loop, GCFMM_TERMS_ARGS)
+
 #define GCFMM_CHANGE_PARAMS                                                                      \
   (std::size_t n, const double *nx, const double *ny, const double *nz, const double *tx,          \
    const double *ty, const double *tz, double *ex, double *ey, double *ez, double *pot, double *r2now, \
@@ -57,6 +80,10 @@ void charge_pair_change(std::size_t n, Separations now, Separations then, Charge
                         gcsimd::SimdPath path) {
   change_kernel_for(path)(n, now.x, now.y, now.z, then.x, then.y, then.z, out.ex, out.ey, out.ez, out.pot,
                           out.r2now, out.r2then);
+}
+
+void charge_terms_at(std::size_t n, Separations at, ChargeTerms out, gcsimd::SimdPath path) {
+  terms_kernel_for(path)(n, at.x, at.y, at.z, out.ex, out.ey, out.ez, out.pot, out.r2);
 }
 
 }  // namespace gcfmm

@@ -34,6 +34,20 @@ struct ChargePairChange {
 void charge_pair_change(std::size_t n, Separations now, Separations then, ChargePairChange out,
                         gcsimd::SimdPath path = gcsimd::default_simd_path());
 
+//! The terms of n separations: (ex, ey, ez, pot)[k] = charge_terms of a unit charge at
+//! separation at_k (zero separation: 0), r2[k] = |at_k|^2 (struct ChargePairChange without
+//! r2then, which may be null here).
+struct ChargeTerms {
+  double *ex, *ey, *ez, *pot;
+  double *r2;
+};
+
+/** @brief For k < n: the terms (d / |d|^3, 1 / |d|) of a unit charge at separation d = at_k and
+ *  |d|^2, bit for bit the `now` half of charge_pair_change on every path (the near refresh
+ *  between evaluations, whose evaluation-time half is held). Outputs must not overlap inputs. */
+void charge_terms_at(std::size_t n, Separations at, ChargeTerms out,
+                     gcsimd::SimdPath path = gcsimd::default_simd_path());
+
 }  // namespace gcfmm
 
 #endif
