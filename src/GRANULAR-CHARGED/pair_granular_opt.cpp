@@ -9,6 +9,8 @@
 
 #include "pair_granular_opt.h"
 
+#include "marshall_lanes.h"
+
 #include "atom.h"
 #include "comm.h"
 #include "error.h"
@@ -34,6 +36,7 @@ using namespace LAMMPS_NS;
 using namespace Granular_NS;
 using namespace MathExtra;
 namespace MK = MarshallKernels;
+namespace ML = MarshallLanes;
 
 /* ---------------------------------------------------------------------- */
 
@@ -493,105 +496,133 @@ bigint PairGranularOpt::compute_generic_pairs(int eflag, int vflag)
 }
 
 /* ----------------------------------------------------------------------
-   the fused contacts in list order: kernel, scatter, the sleepers' bookkeeping
+   the fused contacts in list order, a chunk at a time (its lanes blocks stay in the L1
+   cache): the adhesive contacts gathered into lanes blocks and evaluated by the lanes kernel
+   (marshall_lanes.h) on the default SIMD path, the others (no adhesion: Hertz's law) by the
+   scalar instantiation of the same kernel; then scatter and the sleepers' bookkeeping per
+   contact in list order, so the sums over contacts are those of a scalar loop
 ------------------------------------------------------------------------- */
 
 void PairGranularOpt::compute_fused_contacts()
 {
+  constexpr int W = ML::WIDTH;
+  constexpr std::size_t CHUNK = 8 * W;
   double *special_lj = force->special_lj;
+  const int *type = atom->type;
+  const std::size_t n = contacts.size();
+  lane_in.resize(CHUNK * ML::N_INPUT);
+  lane_out.resize(CHUNK * ML::N_OUTPUT);
+  lane_of.resize(CHUNK);
+  // lane l's first input and output: block l / W, offset l % W, WIDTH apart
+  auto lane_input = [&](int l) { return &lane_in[(l / W) * ML::N_INPUT * W + l % W]; };
+  auto lane_output = [&](int l) { return &lane_out[(l / W) * ML::N_OUTPUT * W + l % W]; };
   std::size_t next_root = 0;
-  for (const Contact &c : contacts) {
-    int j = list->firstneigh[c.i][c.jj];
-    const double factor_lj = special_lj[sbmask(j)];
-    j &= NEIGHMASK;
-    PairForces pf;
-    fused_contact(c, j, next_root, pf);
-    scatter(c.i, j, factor_lj, pf);
+  for (std::size_t start = 0; start < n; start += CHUNK) {
+    const std::size_t m = std::min(CHUNK, n - start);
+    int nlanes = 0;
+    for (std::size_t k = 0; k < m; k++) {
+      const Contact &c = contacts[start + k];
+      const int j = list->firstneigh[c.i][c.jj] & NEIGHMASK;
+      if (fused[types_indices[type[c.i]][type[j]]].gamma == 0.0) {
+        lane_of[k] = -1;
+        continue;
+      }
+      lane_of[k] = nlanes;
+      gather_contact(c, j, jkr_root[next_root++], lane_input(nlanes), W);
+      nlanes++;
+    }
+    // a short last block: its other lanes evaluate copies of its first contact, not scattered
+    const int nblocks = (nlanes + W - 1) / W;
+    for (int l = nlanes; l < nblocks * W; l++) {
+      const double *first = lane_input(l - l % W);
+      double *pad = lane_input(l);
+      for (int q = 0; q < ML::N_INPUT; q++) pad[q * W] = first[q * W];
+    }
+    ML::contacts_in_lanes(nblocks, lane_in.data(), lane_out.data(), history_update);
+
+    for (std::size_t k = 0; k < m; k++) {
+      const Contact &c = contacts[start + k];
+      int j = list->firstneigh[c.i][c.jj];
+      const double factor_lj = special_lj[sbmask(j)];
+      j &= NEIGHMASK;
+      if (lane_of[k] >= 0) {
+        scatter_contact(c, j, factor_lj, lane_input(lane_of[k]), lane_output(lane_of[k]), W);
+      } else {
+        double in[ML::N_INPUT], out[ML::N_OUTPUT];
+        gather_contact(c, j, 1.0, in, 1);
+        ML::marshall_contact(in, out, history_update);
+        scatter_contact(c, j, factor_lj, in, out, 1);
+      }
+    }
   }
 }
 
 /* ----------------------------------------------------------------------
-   the fused kernel for one contact (GranularModel::calculate_forces with the Marshall set)
+   the inputs of the kernel for one contact (marshall_lanes.h), input q at in[q * stride]; s
+   is its JKR root (unused without adhesion)
 ------------------------------------------------------------------------- */
 
-void PairGranularOpt::fused_contact(const Contact &c, int j, std::size_t &next_root,
-                                    PairForces &pf)
+void PairGranularOpt::gather_contact(const Contact &c, int j, double s, double *in,
+                                     int stride) const
 {
   const int i = c.i;
-  const FusedMarshall &fm = fused[types_indices[atom->type[i]][atom->type[j]]];
-  double **x = atom->x, **v = atom->v, **omega = atom->omega;
-  const double radi = atom->radius[i], radj = atom->radius[j];
+  const int model = types_indices[atom->type[i]][atom->type[j]];
+  const FusedMarshall &fm = fused[model];
+  const double *xi = atom->x[i], *xj = atom->x[j], *vi = atom->v[i], *vj = atom->v[j];
+  const double *wi = atom->omega[i], *wj = atom->omega[j];
   const double reff = c.scales.reff;
-  double *history = &fix_history->firstvalue[i][get_size_history() * c.jj];
-  const double dt = models_list[types_indices[atom->type[i]][atom->type[j]]]->dt;
-
-  double *dx = pf.dx;
-  sub3(x[i], x[j], dx);
-  const double rsq = lensq3(dx);
-  const double sqrt_mass = MK::damping_sqrt_mass(fm.mass_factor, effective_mass(i, j));
-
-  // kinematics (GranularModel::calculate_forces)
-  const double r = sqrt(rsq);
-  const double rinv = 1.0 / r;
-  const double delta = radi + radj - r;
-  double vr[3], nx[3], vn[3], vt[3], wr[3], temp[3], vtr[3];
-  sub3(v[i], v[j], vr);
-  scale3(rinv, dx, nx);
-  const double vnnr = dot3(vr, nx);
-  scale3(vnnr, nx, vn);
-  sub3(vr, vn, vt);
-  scaleadd3(radi, omega[i], radj, omega[j], wr);
-  cross3(wr, nx, temp);
-  sub3(vt, temp, vtr);
-
-  // normal: JKR with Marshall damping (the root from the batch)
-  const MK::NormalForce nf = (fm.gamma != 0.0)
-      ? MK::jkr_normal_force_of_root(c.scales.scales, jkr_root[next_root++])
-      : MK::jkr_normal_force(c.scales.scales, fm.gamma, fm.emix, delta, reff);
-  const double damp_prefactor = MK::damping_prefactor(fm.alpha, sqrt_mass, nf);
-  const double fntot = nf.fne + (-damp_prefactor * vnnr);
-  const double fncrit = MK::critical_force(nf);
-
-  // sliding
-  double fs[3];
-  MK::tangential_force(&history[hist_tangential], nx, vtr, dt, fm.k_t * nf.a, damp_prefactor,
-                       fncrit * fm.mu, history_update, fs);
-
-  scale3(fntot, nx, pf.forces);
-  add3(pf.forces, fs, pf.forces);
-  cross3(nx, fs, pf.torquesi);
-  scale3(-1, pf.torquesi);
-  copy3(pf.torquesi, pf.torquesj);
-  scale3(radi - 0.5 * delta, pf.torquesi);
-  scale3(radj - 0.5 * delta, pf.torquesj);
-
-  if (!fm.rolling && !fm.twisting) return;
-  double relrot[3];
-  sub3(omega[i], omega[j], relrot);
-  if (fm.rolling) {
-    // rolling velocity, eq. 31 of Wang et al, Particuology 23, 49 (2015)
-    double vrl[3], fr[3], torroll[3];
-    vrl[0] = reff * (relrot[1] * nx[2] - relrot[2] * nx[1]);
-    vrl[1] = reff * (relrot[2] * nx[0] - relrot[0] * nx[2]);
-    vrl[2] = reff * (relrot[0] * nx[1] - relrot[1] * nx[0]);
-    MK::rolling_force(&history[hist_rolling], nx, vrl, dt,
-                      fm.theta_crit * (fm.roll_radius_factor * reff), nf.adhesive / reff,
-                      history_update, fr);
-    cross3(nx, fr, torroll);
-    scale3(reff, torroll);
-    add3(pf.torquesi, torroll, pf.torquesi);
-    sub3(pf.torquesj, torroll, pf.torquesj);
+  const double *history = &fix_history->firstvalue[i][get_size_history() * c.jj];
+  auto put = [in, stride](int q, double value) { in[q * stride] = value; };
+  for (int k = 0; k < 3; k++) {
+    put(ML::DX + k, xi[k] - xj[k]);
+    put(ML::VR + k, vi[k] - vj[k]);
+    put(ML::OMEGA_I + k, wi[k]);
+    put(ML::OMEGA_J + k, wj[k]);
+    put(ML::HIST_T + k, history[hist_tangential + k]);
+    put(ML::HIST_R + k, fm.rolling ? history[hist_rolling + k] : 0.0);
   }
-  if (fm.twisting) {
-    // omega_T (eq. 29 of Marshall 2009)
-    const double magtwist = dot3(relrot, nx);
-    const double moment = MK::twisting_moment(history[hist_twisting], magtwist, dt, nf.a, fm.k_t,
-                                              damp_prefactor, fm.mu * fncrit, history_update);
-    double tortwist[3];
-    scale3(moment, nx, tortwist);
-    add3(pf.torquesi, tortwist, pf.torquesi);
-    sub3(pf.torquesj, tortwist, pf.torquesj);
+  put(ML::HIST_TW, fm.twisting ? history[hist_twisting] : 0.0);
+  put(ML::RAD_I, atom->radius[i]);
+  put(ML::RAD_J, atom->radius[j]);
+  put(ML::REFF, reff);
+  put(ML::ROOT, s);
+  put(ML::ASEP, c.scales.scales.asep);
+  put(ML::FC, c.scales.scales.fc);
+  put(ML::SQRT_KN_SEP, c.scales.scales.sqrt_kn_sep);
+  put(ML::SQRT_MASS, MK::damping_sqrt_mass(fm.mass_factor, effective_mass(i, j)));
+  put(ML::ALPHA, fm.alpha);
+  put(ML::K_T, fm.k_t);
+  put(ML::MU, fm.mu);
+  put(ML::DT, models_list[model]->dt);
+  put(ML::XI_CRIT, fm.rolling ? fm.theta_crit * (fm.roll_radius_factor * reff) : 0.0);
+  put(ML::ROLLING, fm.rolling ? 1.0 : 0.0);
+  put(ML::TWISTING, fm.twisting ? 1.0 : 0.0);
+  put(ML::HERTZ, fm.gamma == 0.0 ? 1.0 : 0.0);
+  put(ML::EMIX, fm.emix);
+}
+
+/* ----------------------------------------------------------------------
+   the results of one contact back: its histories (the sub-models it has), then forces and
+   torques through scatter(); input and output q at in[q * stride], out[q * stride]
+------------------------------------------------------------------------- */
+
+void PairGranularOpt::scatter_contact(const Contact &c, int j, double factor_lj,
+                                      const double *in, const double *out, int stride)
+{
+  const FusedMarshall &fm = fused[types_indices[atom->type[c.i]][atom->type[j]]];
+  double *history = &fix_history->firstvalue[c.i][get_size_history() * c.jj];
+  auto get = [stride](const double *from, int q) { return from[q * stride]; };
+  PairForces pf;
+  for (int k = 0; k < 3; k++) {
+    history[hist_tangential + k] = get(out, ML::OUT_HIST_T + k);
+    if (fm.rolling) history[hist_rolling + k] = get(out, ML::OUT_HIST_R + k);
+    pf.forces[k] = get(out, ML::FORCE + k);
+    pf.torquesi[k] = get(out, ML::TORQUE_I + k);
+    pf.torquesj[k] = get(out, ML::TORQUE_J + k);
+    pf.dx[k] = get(in, ML::DX + k);
   }
+  if (fm.twisting) history[hist_twisting] = get(out, ML::OUT_HIST_TW);
+  scatter(c.i, j, factor_lj, pf);
 }
 
 /* ----------------------------------------------------------------------

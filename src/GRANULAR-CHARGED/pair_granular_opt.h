@@ -91,6 +91,10 @@ class PairGranularOpt : public PairGranular {
   };
   std::vector<Contact> contacts;
   std::vector<double> jkr_overlap, jkr_root;    // the adhesive contacts' scaled overlaps, roots
+  // lanes blocks of one chunk of contacts (marshall_lanes.h) and each contact's lane (-1: the
+  // scalar kernel)
+  std::vector<double> lane_in, lane_out;
+  std::vector<int> lane_of;
   struct PairForces {
     double forces[3], torquesi[3], torquesj[3], dx[3];
   };
@@ -116,7 +120,11 @@ class PairGranularOpt : public PairGranular {
   void gather_contacts();
   bigint compute_generic_pairs(int eflag, int vflag);
   void compute_fused_contacts();
-  void fused_contact(const Contact &c, int j, std::size_t &next_root, PairForces &pf);
+  // one contact's inputs of the kernel of marshall_lanes.h (input q at in[q * stride]) and
+  // its results back to the atoms and the history
+  void gather_contact(const Contact &c, int j, double s, double *in, int stride) const;
+  void scatter_contact(const Contact &c, int j, double factor_lj, const double *in,
+                       const double *out, int stride);
   void scatter(int i, int j, double factor_lj, PairForces &pf);
   PairScales scales_of(int i, int j, const FusedMarshall &fm) const;
   double effective_mass(int i, int j) const;
