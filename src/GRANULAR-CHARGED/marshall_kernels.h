@@ -205,9 +205,9 @@ namespace MarshallKernels {
   }
 
   // sqrt(mass_factor m*): the mass part of eta_N, a constant of a pair of particles
-  inline double damping_sqrt_mass(double mass_factor, double meff)
+  template <class T> GC_KERNEL_INLINE T damping_sqrt_mass(T mass_factor, T meff)
   {
-    return sqrt(mass_factor * meff);
+    return NumberOps<T>::sqrt(mass_factor * meff);
   }
 
   // eta_N = alpha sqrt(mass_factor m*) sqrt(k_N); a >= 0.30285 a_0 > 0 for every live JKR

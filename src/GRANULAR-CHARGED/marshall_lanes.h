@@ -79,7 +79,10 @@ namespace MarshallLanes {
     ASEP,                // a_sep, F_C, sqrt(4/3 E* a_sep): JKRScales
     FC,
     SQRT_KN_SEP,
-    SQRT_MASS,           // sqrt(mass_factor m*)
+    MASS_FACTOR,         // damping marshall 2, marshall/printed 1
+    MASS_I,              // mass of i
+    MASS_J,              // mass of j
+    FIXED,               // FIXED_NONE, FIXED_I or FIXED_J: which one is a fixed body
     ALPHA,               // damping alpha(e)
     K_T,                 // 8 G*
     MU,                  // sliding friction coefficient
@@ -104,6 +107,15 @@ namespace MarshallLanes {
     OUT_HIST_TW = 15,
     N_OUTPUT
   };
+
+  // a frozen atom (fix freeze) or a sleeper is a fixed body: m* is the other's mass
+  constexpr double FIXED_NONE = 0.0, FIXED_I = 1.0, FIXED_J = 2.0;
+  template <class T> GC_KERNEL_INLINE T effective_mass(T mass_i, T mass_j, T fixed)
+  {
+    using N = MarshallKernels::NumberOps<T>;
+    return N::select(fixed == FIXED_J, mass_i,
+                     N::select(fixed == FIXED_I, mass_j, mass_i * mass_j / (mass_i + mass_j)));
+  }
 
   /* ---------------------------------------------------------------------
      GranularModel::calculate_forces with the Marshall set, in its order of operations
@@ -136,7 +148,9 @@ namespace MarshallLanes {
     if constexpr (std::is_same_v<T, double>) {
       if (in[HERTZ] != 0.0) nf = MK::hertz_normal_force(in[EMIX], delta, reff);
     }
-    const T damp_prefactor = MK::damping_prefactor(in[ALPHA], in[SQRT_MASS], nf);
+    const T meff = effective_mass(in[MASS_I], in[MASS_J], in[FIXED]);
+    const T sqrt_mass = MK::damping_sqrt_mass(in[MASS_FACTOR], meff);
+    const T damp_prefactor = MK::damping_prefactor(in[ALPHA], sqrt_mass, nf);
     const T fntot = nf.fne + (-damp_prefactor * vnnr);
     const T fncrit = MK::critical_force(nf);
 

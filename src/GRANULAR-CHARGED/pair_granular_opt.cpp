@@ -425,7 +425,8 @@ void PairGranularOpt::gather_contacts()
       touch[jj] = 1;
       if (fm.gamma != 0.0)
         jkr_overlap.push_back(MK::scaled_overlap(ps.scales, radsum - sqrt(rsq)));
-      contacts.push_back({i, jj, ps});
+      contacts.push_back({i, jj, j, types_indices[type[i]][type[j]],
+                          special_lj[sbmask(jlist[jj])], ps});
     }
   }
 }
@@ -507,8 +508,6 @@ void PairGranularOpt::compute_fused_contacts()
 {
   constexpr int W = ML::WIDTH;
   constexpr std::size_t CHUNK = 8 * W;
-  double *special_lj = force->special_lj;
-  const int *type = atom->type;
   const std::size_t n = contacts.size();
   lane_in.resize(CHUNK * ML::N_INPUT);
   lane_out.resize(CHUNK * ML::N_OUTPUT);
@@ -516,19 +515,90 @@ void PairGranularOpt::compute_fused_contacts()
   // lane l's first input and output: block l / W, offset l % W, WIDTH apart
   auto lane_input = [&](int l) { return &lane_in[(l / W) * ML::N_INPUT * W + l % W]; };
   auto lane_output = [&](int l) { return &lane_out[(l / W) * ML::N_OUTPUT * W + l % W]; };
+
+  double **x = atom->x, **v = atom->v, **omega = atom->omega;
+  const double *radius = atom->radius, *rmass = atom->rmass;
+  const int *mask = atom->mask;
+  const double *asleep = sleep.asleep;
+  double **allhistory = fix_history->firstvalue;
+  const int size_hist = get_size_history();
+  // the inputs of one contact (marshall_lanes.h), input q at in[q * stride]; s is its JKR root
+  // (unused without adhesion)
+  auto gather_contact = [&](const Contact &c, double s, double *in, int stride) {
+    const int i = c.i, j = c.j;
+    const int model = c.model;
+    const FusedMarshall &fm = fused[model];
+    const double reff = c.scales.reff;
+    const double *history = &allhistory[i][size_hist * c.jj];
+    auto put = [in, stride](int q, double value) { in[q * stride] = value; };
+    for (int k = 0; k < 3; k++) {
+      put(ML::DX + k, x[i][k] - x[j][k]);
+      put(ML::VR + k, v[i][k] - v[j][k]);
+      put(ML::OMEGA_I + k, omega[i][k]);
+      put(ML::OMEGA_J + k, omega[j][k]);
+      put(ML::HIST_T + k, history[hist_tangential + k]);
+      put(ML::HIST_R + k, fm.rolling ? history[hist_rolling + k] : 0.0);
+    }
+    put(ML::HIST_TW, fm.twisting ? history[hist_twisting] : 0.0);
+    put(ML::RAD_I, radius[i]);
+    put(ML::RAD_J, radius[j]);
+    put(ML::REFF, reff);
+    put(ML::ROOT, s);
+    put(ML::ASEP, c.scales.scales.asep);
+    put(ML::FC, c.scales.scales.fc);
+    put(ML::SQRT_KN_SEP, c.scales.scales.sqrt_kn_sep);
+    put(ML::MASS_FACTOR, fm.mass_factor);
+    put(ML::MASS_I, rmass[i]);
+    put(ML::MASS_J, rmass[j]);
+    // a frozen atom or a sleeper is a fixed body, in this order of precedence
+    double fixed = ML::FIXED_NONE;
+    if (mask[i] & freeze_group_bit) fixed = ML::FIXED_I;
+    if (mask[j] & freeze_group_bit) fixed = ML::FIXED_J;
+    if (asleep && asleep[i] != 0.0) fixed = ML::FIXED_I;
+    if (asleep && asleep[j] != 0.0) fixed = ML::FIXED_J;
+    put(ML::FIXED, fixed);
+    put(ML::ALPHA, fm.alpha);
+    put(ML::K_T, fm.k_t);
+    put(ML::MU, fm.mu);
+    put(ML::DT, model_dt[model]);
+    put(ML::XI_CRIT, fm.rolling ? fm.theta_crit * (fm.roll_radius_factor * reff) : 0.0);
+    put(ML::ROLLING, fm.rolling ? 1.0 : 0.0);
+    put(ML::TWISTING, fm.twisting ? 1.0 : 0.0);
+    put(ML::HERTZ, fm.gamma == 0.0 ? 1.0 : 0.0);
+    put(ML::EMIX, fm.emix);
+  };
+  // the results of one contact back: its histories (the sub-models it has), then forces and
+  // torques through scatter(); input and output q at in[q * stride], out[q * stride]
+  auto scatter_contact = [&](const Contact &c, const double *in, const double *out, int stride) {
+    const FusedMarshall &fm = fused[c.model];
+    double *history = &allhistory[c.i][size_hist * c.jj];
+    PairForces pf;
+    for (int k = 0; k < 3; k++) {
+      history[hist_tangential + k] = out[(ML::OUT_HIST_T + k) * stride];
+      if (fm.rolling) history[hist_rolling + k] = out[(ML::OUT_HIST_R + k) * stride];
+      pf.forces[k] = out[(ML::FORCE + k) * stride];
+      pf.torquesi[k] = out[(ML::TORQUE_I + k) * stride];
+      pf.torquesj[k] = out[(ML::TORQUE_J + k) * stride];
+      pf.dx[k] = in[(ML::DX + k) * stride];
+    }
+    if (fm.twisting) history[hist_twisting] = out[ML::OUT_HIST_TW * stride];
+    scatter(c.i, c.j, c.factor_lj, pf);
+  };
+
+  model_dt.resize(nmodels);
+  for (int m = 0; m < nmodels; m++) model_dt[m] = models_list[m]->dt;
   std::size_t next_root = 0;
   for (std::size_t start = 0; start < n; start += CHUNK) {
     const std::size_t m = std::min(CHUNK, n - start);
     int nlanes = 0;
     for (std::size_t k = 0; k < m; k++) {
       const Contact &c = contacts[start + k];
-      const int j = list->firstneigh[c.i][c.jj] & NEIGHMASK;
-      if (fused[types_indices[type[c.i]][type[j]]].gamma == 0.0) {
+      if (fused[c.model].gamma == 0.0) {
         lane_of[k] = -1;
         continue;
       }
       lane_of[k] = nlanes;
-      gather_contact(c, j, jkr_root[next_root++], lane_input(nlanes), W);
+      gather_contact(c, jkr_root[next_root++], lane_input(nlanes), W);
       nlanes++;
     }
     // a short last block: its other lanes evaluate copies of its first contact, not scattered
@@ -542,105 +612,16 @@ void PairGranularOpt::compute_fused_contacts()
 
     for (std::size_t k = 0; k < m; k++) {
       const Contact &c = contacts[start + k];
-      int j = list->firstneigh[c.i][c.jj];
-      const double factor_lj = special_lj[sbmask(j)];
-      j &= NEIGHMASK;
       if (lane_of[k] >= 0) {
-        scatter_contact(c, j, factor_lj, lane_input(lane_of[k]), lane_output(lane_of[k]), W);
+        scatter_contact(c, lane_input(lane_of[k]), lane_output(lane_of[k]), W);
       } else {
         double in[ML::N_INPUT], out[ML::N_OUTPUT];
-        gather_contact(c, j, 1.0, in, 1);
+        gather_contact(c, 1.0, in, 1);
         ML::marshall_contact(in, out, history_update);
-        scatter_contact(c, j, factor_lj, in, out, 1);
+        scatter_contact(c, in, out, 1);
       }
     }
   }
-}
-
-/* ----------------------------------------------------------------------
-   the inputs of the kernel for one contact (marshall_lanes.h), input q at in[q * stride]; s
-   is its JKR root (unused without adhesion)
-------------------------------------------------------------------------- */
-
-void PairGranularOpt::gather_contact(const Contact &c, int j, double s, double *in,
-                                     int stride) const
-{
-  const int i = c.i;
-  const int model = types_indices[atom->type[i]][atom->type[j]];
-  const FusedMarshall &fm = fused[model];
-  const double *xi = atom->x[i], *xj = atom->x[j], *vi = atom->v[i], *vj = atom->v[j];
-  const double *wi = atom->omega[i], *wj = atom->omega[j];
-  const double reff = c.scales.reff;
-  const double *history = &fix_history->firstvalue[i][get_size_history() * c.jj];
-  auto put = [in, stride](int q, double value) { in[q * stride] = value; };
-  for (int k = 0; k < 3; k++) {
-    put(ML::DX + k, xi[k] - xj[k]);
-    put(ML::VR + k, vi[k] - vj[k]);
-    put(ML::OMEGA_I + k, wi[k]);
-    put(ML::OMEGA_J + k, wj[k]);
-    put(ML::HIST_T + k, history[hist_tangential + k]);
-    put(ML::HIST_R + k, fm.rolling ? history[hist_rolling + k] : 0.0);
-  }
-  put(ML::HIST_TW, fm.twisting ? history[hist_twisting] : 0.0);
-  put(ML::RAD_I, atom->radius[i]);
-  put(ML::RAD_J, atom->radius[j]);
-  put(ML::REFF, reff);
-  put(ML::ROOT, s);
-  put(ML::ASEP, c.scales.scales.asep);
-  put(ML::FC, c.scales.scales.fc);
-  put(ML::SQRT_KN_SEP, c.scales.scales.sqrt_kn_sep);
-  put(ML::SQRT_MASS, MK::damping_sqrt_mass(fm.mass_factor, effective_mass(i, j)));
-  put(ML::ALPHA, fm.alpha);
-  put(ML::K_T, fm.k_t);
-  put(ML::MU, fm.mu);
-  put(ML::DT, models_list[model]->dt);
-  put(ML::XI_CRIT, fm.rolling ? fm.theta_crit * (fm.roll_radius_factor * reff) : 0.0);
-  put(ML::ROLLING, fm.rolling ? 1.0 : 0.0);
-  put(ML::TWISTING, fm.twisting ? 1.0 : 0.0);
-  put(ML::HERTZ, fm.gamma == 0.0 ? 1.0 : 0.0);
-  put(ML::EMIX, fm.emix);
-}
-
-/* ----------------------------------------------------------------------
-   the results of one contact back: its histories (the sub-models it has), then forces and
-   torques through scatter(); input and output q at in[q * stride], out[q * stride]
-------------------------------------------------------------------------- */
-
-void PairGranularOpt::scatter_contact(const Contact &c, int j, double factor_lj,
-                                      const double *in, const double *out, int stride)
-{
-  const FusedMarshall &fm = fused[types_indices[atom->type[c.i]][atom->type[j]]];
-  double *history = &fix_history->firstvalue[c.i][get_size_history() * c.jj];
-  auto get = [stride](const double *from, int q) { return from[q * stride]; };
-  PairForces pf;
-  for (int k = 0; k < 3; k++) {
-    history[hist_tangential + k] = get(out, ML::OUT_HIST_T + k);
-    if (fm.rolling) history[hist_rolling + k] = get(out, ML::OUT_HIST_R + k);
-    pf.forces[k] = get(out, ML::FORCE + k);
-    pf.torquesi[k] = get(out, ML::TORQUE_I + k);
-    pf.torquesj[k] = get(out, ML::TORQUE_J + k);
-    pf.dx[k] = get(in, ML::DX + k);
-  }
-  if (fm.twisting) history[hist_twisting] = get(out, ML::OUT_HIST_TW);
-  scatter(c.i, j, factor_lj, pf);
-}
-
-/* ----------------------------------------------------------------------
-   m* of pair i, j; a frozen atom (fix freeze) or a sleeper is a fixed body: the other's mass
-------------------------------------------------------------------------- */
-
-double PairGranularOpt::effective_mass(int i, int j) const
-{
-  const double mi = atom->rmass[i], mj = atom->rmass[j];
-  double meff = mi * mj / (mi + mj);
-  const int *mask = atom->mask;
-  if (mask[i] & freeze_group_bit) meff = mj;
-  if (mask[j] & freeze_group_bit) meff = mi;
-  if (sleep.asleep) {
-    if (sleep.asleep[i] != 0.0) meff = mj;
-    if (sleep.asleep[j] != 0.0) meff = mi;
-  }
-  return meff;
 }
 
 /* ----------------------------------------------------------------------

@@ -84,9 +84,11 @@ class PairGranularOpt : public PairGranular {
   };
   std::vector<double> type_radius;       // radius of every atom of a type (-1: none)
   std::vector<PairScales> pair_scales;   // per type pair (itype * (ntypes + 1) + jtype)
-  // one fused contact of this compute(): atom, index in its neighbor list, its scales
+  // one fused contact of this compute(): atom, index in its neighbor list, the neighbor, its
+  // model, special factor and scales
   struct Contact {
-    int i, jj;
+    int i, jj, j, model;
+    double factor_lj;
     PairScales scales;
   };
   std::vector<Contact> contacts;
@@ -95,6 +97,7 @@ class PairGranularOpt : public PairGranular {
   // scalar kernel)
   std::vector<double> lane_in, lane_out;
   std::vector<int> lane_of;
+  std::vector<double> model_dt;          // time step of each model
   struct PairForces {
     double forces[3], torquesi[3], torquesj[3], dx[3];
   };
@@ -120,14 +123,8 @@ class PairGranularOpt : public PairGranular {
   void gather_contacts();
   bigint compute_generic_pairs(int eflag, int vflag);
   void compute_fused_contacts();
-  // one contact's inputs of the kernel of marshall_lanes.h (input q at in[q * stride]) and
-  // its results back to the atoms and the history
-  void gather_contact(const Contact &c, int j, double s, double *in, int stride) const;
-  void scatter_contact(const Contact &c, int j, double factor_lj, const double *in,
-                       const double *out, int stride);
   void scatter(int i, int j, double factor_lj, PairForces &pf);
   PairScales scales_of(int i, int j, const FusedMarshall &fm) const;
-  double effective_mass(int i, int j) const;
 };
 
 }    // namespace LAMMPS_NS
