@@ -15,7 +15,6 @@
 #include "gcsimd/simd.hpp"
 #include "gcsimd/simd_paths.hpp"
 
-#include <cstring>
 
 namespace {
 
@@ -26,10 +25,10 @@ GCSIMD_ALWAYS_INLINE void lanes_blocks(std::size_t nblocks, const double *__rest
                                        double *__restrict out)
 {
   for (std::size_t b = 0; b < nblocks; ++b) {
-    Lanes lanes_in[N_INPUT], lanes_out[N_OUTPUT];
-    std::memcpy(lanes_in, in + b * N_INPUT * WIDTH, sizeof(lanes_in));
-    marshall_contact(lanes_in, lanes_out, HISTORY_UPDATE);
-    std::memcpy(out + b * N_OUTPUT * WIDTH, lanes_out, sizeof(lanes_out));
+    // the block read and written in place, one vector per input and output
+    const auto *block_in = reinterpret_cast<const LanesInMemory *>(in + b * N_INPUT * WIDTH);
+    auto *block_out = reinterpret_cast<LanesInMemory *>(out + b * N_OUTPUT * WIDTH);
+    marshall_contact<LanesInMemory, Lanes>(block_in, block_out, HISTORY_UPDATE);
   }
 }
 

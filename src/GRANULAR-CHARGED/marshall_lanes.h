@@ -35,6 +35,10 @@ namespace MarshallLanes {
   constexpr int WIDTH = 8;
   using Lanes = double __attribute__((vector_size(8 * WIDTH)));
   using LaneMask = decltype(Lanes{} < Lanes{});
+  // the lanes in the blocks of the buffers: any alignment of a double, and read or written
+  // as doubles elsewhere
+  using LanesInMemory = double
+      __attribute__((vector_size(8 * WIDTH), aligned(alignof(double)), may_alias));
 }    // namespace MarshallLanes
 
 // GCC notes that a 64-byte vector passed by value has another ABI without AVX-512: these
@@ -121,14 +125,15 @@ namespace MarshallLanes {
      GranularModel::calculate_forces with the Marshall set, in its order of operations
   --------------------------------------------------------------------- */
 
-  template <class T>
-  GC_KERNEL_INLINE void marshall_contact(const T *in, T *out,
-                                                              bool history_update)
+  template <class Memory, class T = Memory>
+  GC_KERNEL_INLINE void marshall_contact(const Memory *inputs, Memory *out, bool history_update)
   {
     namespace MK = MarshallKernels;
     using N = MK::NumberOps<T>;
-    const T *dx = &in[DX];
-    const T radi = in[RAD_I], radj = in[RAD_J], reff = in[REFF];
+    auto in = [inputs](int q) -> T { return inputs[q]; };
+    const T dx[3] = {in(DX), in(DX + 1), in(DX + 2)};
+    const T vr[3] = {in(VR), in(VR + 1), in(VR + 2)};
+    const T radi = in(RAD_I), radj = in(RAD_J), reff = in(REFF);
 
     // kinematics
     const T r = N::sqrt(MK::lensq3(dx));
@@ -136,31 +141,31 @@ namespace MarshallLanes {
     const T delta = radi + radj - r;
     T nx[3], vt[3], wr[3], temp[3], vtr[3];
     for (int k = 0; k < 3; k++) nx[k] = rinv * dx[k];
-    const T vnnr = MK::dot3(&in[VR], nx);
-    for (int k = 0; k < 3; k++) vt[k] = in[VR + k] - vnnr * nx[k];
-    for (int k = 0; k < 3; k++) wr[k] = radi * in[OMEGA_I + k] + radj * in[OMEGA_J + k];
+    const T vnnr = MK::dot3(vr, nx);
+    for (int k = 0; k < 3; k++) vt[k] = vr[k] - vnnr * nx[k];
+    for (int k = 0; k < 3; k++) wr[k] = radi * in(OMEGA_I + k) + radj * in(OMEGA_J + k);
     MK::cross3(wr, nx, temp);
     for (int k = 0; k < 3; k++) vtr[k] = vt[k] - temp[k];
 
     // normal: JKR from the root with Marshall damping
-    MK::NormalForceT<T> nf = MK::jkr_normal_force_of_root(in[ASEP], in[FC], in[SQRT_KN_SEP],
-                                                          in[ROOT]);
+    MK::NormalForceT<T> nf = MK::jkr_normal_force_of_root(in(ASEP), in(FC), in(SQRT_KN_SEP),
+                                                          in(ROOT));
     if constexpr (std::is_same_v<T, double>) {
-      if (in[HERTZ] != 0.0) nf = MK::hertz_normal_force(in[EMIX], delta, reff);
+      if (in(HERTZ) != 0.0) nf = MK::hertz_normal_force(in(EMIX), delta, reff);
     }
-    const T meff = effective_mass(in[MASS_I], in[MASS_J], in[FIXED]);
-    const T sqrt_mass = MK::damping_sqrt_mass(in[MASS_FACTOR], meff);
-    const T damp_prefactor = MK::damping_prefactor(in[ALPHA], sqrt_mass, nf);
+    const T meff = effective_mass(in(MASS_I), in(MASS_J), in(FIXED));
+    const T sqrt_mass = MK::damping_sqrt_mass(in(MASS_FACTOR), meff);
+    const T damp_prefactor = MK::damping_prefactor(in(ALPHA), sqrt_mass, nf);
     const T fntot = nf.fne + (-damp_prefactor * vnnr);
     const T fncrit = MK::critical_force(nf);
 
     // sliding
-    T hist_t[3] = {in[HIST_T], in[HIST_T + 1], in[HIST_T + 2]};
+    T hist_t[3] = {in(HIST_T), in(HIST_T + 1), in(HIST_T + 2)};
     T fs[3];
-    MK::tangential_force(hist_t, nx, vtr, in[DT], in[K_T] * nf.a, damp_prefactor,
-                         fncrit * in[MU], history_update, fs);
+    MK::tangential_force(hist_t, nx, vtr, in(DT), in(K_T) * nf.a, damp_prefactor,
+                         fncrit * in(MU), history_update, fs);
 
-    T *force = &out[FORCE], *torque_i = &out[TORQUE_I], *torque_j = &out[TORQUE_J];
+    T force[3], torque_i[3], torque_j[3];
     for (int k = 0; k < 3; k++) force[k] = fntot * nx[k] + fs[k];
     T nxfs[3];
     MK::cross3(nx, fs, nxfs);
@@ -172,18 +177,18 @@ namespace MarshallLanes {
     }
 
     T relrot[3];
-    for (int k = 0; k < 3; k++) relrot[k] = in[OMEGA_I + k] - in[OMEGA_J + k];
+    for (int k = 0; k < 3; k++) relrot[k] = in(OMEGA_I + k) - in(OMEGA_J + k);
 
     // rolling velocity, eq. 31 of Wang et al, Particuology 23, 49 (2015)
     T vrl[3], fr[3], torroll[3];
     vrl[0] = reff * (relrot[1] * nx[2] - relrot[2] * nx[1]);
     vrl[1] = reff * (relrot[2] * nx[0] - relrot[0] * nx[2]);
     vrl[2] = reff * (relrot[0] * nx[1] - relrot[1] * nx[0]);
-    T hist_r[3] = {in[HIST_R], in[HIST_R + 1], in[HIST_R + 2]};
-    MK::rolling_force(hist_r, nx, vrl, in[DT], in[XI_CRIT], nf.adhesive / reff, history_update,
+    T hist_r[3] = {in(HIST_R), in(HIST_R + 1), in(HIST_R + 2)};
+    MK::rolling_force(hist_r, nx, vrl, in(DT), in(XI_CRIT), nf.adhesive / reff, history_update,
                       fr);
     MK::cross3(nx, fr, torroll);
-    const auto rolling = in[ROLLING] != 0.0;
+    const auto rolling = in(ROLLING) != 0.0;
     for (int k = 0; k < 3; k++) {
       const T tr = torroll[k] * reff;
       torque_i[k] = N::select(rolling, torque_i[k] + tr, torque_i[k]);
@@ -192,10 +197,10 @@ namespace MarshallLanes {
 
     // twisting: omega_T (eq. 29 of Marshall 2009)
     const T magtwist = MK::dot3(relrot, nx);
-    T phi = in[HIST_TW];
-    const T moment = MK::twisting_moment(phi, magtwist, in[DT], nf.a, in[K_T], damp_prefactor,
-                                         in[MU] * fncrit, history_update);
-    const auto twisting = in[TWISTING] != 0.0;
+    T phi = in(HIST_TW);
+    const T moment = MK::twisting_moment(phi, magtwist, in(DT), nf.a, in(K_T), damp_prefactor,
+                                         in(MU) * fncrit, history_update);
+    const auto twisting = in(TWISTING) != 0.0;
     for (int k = 0; k < 3; k++) {
       const T tt = moment * nx[k];
       torque_i[k] = N::select(twisting, torque_i[k] + tt, torque_i[k]);
@@ -203,10 +208,13 @@ namespace MarshallLanes {
     }
 
     for (int k = 0; k < 3; k++) {
+      out[FORCE + k] = force[k];
+      out[TORQUE_I + k] = torque_i[k];
+      out[TORQUE_J + k] = torque_j[k];
       out[OUT_HIST_T + k] = hist_t[k];
-      out[OUT_HIST_R + k] = N::select(rolling, hist_r[k], in[HIST_R + k]);
+      out[OUT_HIST_R + k] = N::select(rolling, hist_r[k], in(HIST_R + k));
     }
-    out[OUT_HIST_TW] = N::select(twisting, phi, in[HIST_TW]);
+    out[OUT_HIST_TW] = N::select(twisting, phi, in(HIST_TW));
   }
 
   // nblocks blocks of WIDTH contacts: block b's input q of lane l at

@@ -508,6 +508,7 @@ void PairGranularOpt::compute_fused_contacts()
 {
   constexpr int W = ML::WIDTH;
   constexpr std::size_t CHUNK = 8 * W;
+  constexpr std::size_t PREFETCH = 4;
   const std::size_t n = contacts.size();
   lane_in.resize(CHUNK * ML::N_INPUT);
   lane_out.resize(CHUNK * ML::N_OUTPUT);
@@ -593,6 +594,14 @@ void PairGranularOpt::compute_fused_contacts()
     int nlanes = 0;
     for (std::size_t k = 0; k < m; k++) {
       const Contact &c = contacts[start + k];
+      // the neighbor's data a few contacts ahead: each contact's loads then overlap with the
+      // gathering of the previous ones
+      if (start + k + PREFETCH < n) {
+        const int jn = contacts[start + k + PREFETCH].j;
+        __builtin_prefetch(x[jn]);
+        __builtin_prefetch(v[jn]);
+        __builtin_prefetch(omega[jn]);
+      }
       if (fused[c.model].gamma == 0.0) {
         lane_of[k] = -1;
         continue;
@@ -612,6 +621,11 @@ void PairGranularOpt::compute_fused_contacts()
 
     for (std::size_t k = 0; k < m; k++) {
       const Contact &c = contacts[start + k];
+      if (k + PREFETCH < m) {
+        const int jn = contacts[start + k + PREFETCH].j;
+        __builtin_prefetch(atom->f[jn], 1);
+        __builtin_prefetch(atom->torque[jn], 1);
+      }
       if (lane_of[k] >= 0) {
         scatter_contact(c, lane_input(lane_of[k]), lane_output(lane_of[k]), W);
       } else {
