@@ -400,9 +400,11 @@ void PairGranularOpt::gather_contacts()
     const int jnum = list->numneigh[i];
     for (int jj = 0; jj < jnum; jj++) {
       const int j = jlist[jj] & NEIGHMASK;
-      if (special_lj[sbmask(jlist[jj])] == 0) continue;
+      const double factor_lj = special_lj[sbmask(jlist[jj])];
+      if (factor_lj == 0) continue;
       if (asleep && asleep[i] != 0.0 && asleep[j] != 0.0) continue;
-      const FusedMarshall &fm = fused[types_indices[type[i]][type[j]]];
+      const int model = types_indices[type[i]][type[j]];
+      const FusedMarshall &fm = fused[model];
       if (!fm.on) {
         generic_i.push_back(i);
         generic_jj.push_back(jj);
@@ -425,8 +427,7 @@ void PairGranularOpt::gather_contacts()
       touch[jj] = 1;
       if (fm.gamma != 0.0)
         jkr_overlap.push_back(MK::scaled_overlap(ps.scales, radsum - sqrt(rsq)));
-      contacts.push_back({i, jj, j, types_indices[type[i]][type[j]],
-                          special_lj[sbmask(jlist[jj])], ps});
+      contacts.push_back({i, jj, j, model, factor_lj, ps});
     }
   }
 }
