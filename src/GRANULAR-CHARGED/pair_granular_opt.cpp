@@ -524,13 +524,12 @@ void PairGranularOpt::compute_fused_contacts()
   const double *asleep = sleep.asleep;
   double **allhistory = fix_history->firstvalue;
   const int size_hist = get_size_history();
-  // the inputs of one contact (marshall_lanes.h), input q at in[q * stride]; s is its JKR root
-  // (unused without adhesion)
-  auto gather_contact = [&](const Contact &c, double s, double *in, int stride) {
+  // the inputs of one contact (marshall_lanes.h), input q at in[q * stride], in two parts: those
+  // of the contact's atoms and history (s: its JKR root, unused without adhesion) and those of
+  // its model and type pair, the same for every contact of one type pair of one radius each
+  auto gather_own = [&](const Contact &c, double s, double *in, int stride) {
     const int i = c.i, j = c.j;
-    const int model = c.model;
-    const FusedMarshall &fm = fused[model];
-    const double reff = c.scales.reff;
+    const FusedMarshall &fm = fused[c.model];
     const double *history = &allhistory[i][size_hist * c.jj];
     auto put = [in, stride](int q, double value) { in[q * stride] = value; };
     for (int k = 0; k < 3; k++) {
@@ -542,14 +541,7 @@ void PairGranularOpt::compute_fused_contacts()
       put(ML::HIST_R + k, fm.rolling ? history[hist_rolling + k] : 0.0);
     }
     put(ML::HIST_TW, fm.twisting ? history[hist_twisting] : 0.0);
-    put(ML::RAD_I, radius[i]);
-    put(ML::RAD_J, radius[j]);
-    put(ML::REFF, reff);
     put(ML::ROOT, s);
-    put(ML::ASEP, c.scales.scales.asep);
-    put(ML::FC, c.scales.scales.fc);
-    put(ML::SQRT_KN_SEP, c.scales.scales.sqrt_kn_sep);
-    put(ML::MASS_FACTOR, fm.mass_factor);
     put(ML::MASS_I, rmass[i]);
     put(ML::MASS_J, rmass[j]);
     // a frozen atom or a sleeper is a fixed body, in this order of precedence
@@ -559,15 +551,31 @@ void PairGranularOpt::compute_fused_contacts()
     if (asleep && asleep[i] != 0.0) fixed = ML::FIXED_I;
     if (asleep && asleep[j] != 0.0) fixed = ML::FIXED_J;
     put(ML::FIXED, fixed);
+  };
+  auto gather_shared = [&](const Contact &c, double *in, int stride) {
+    const FusedMarshall &fm = fused[c.model];
+    const double reff = c.scales.reff;
+    auto put = [in, stride](int q, double value) { in[q * stride] = value; };
+    put(ML::RAD_I, radius[c.i]);
+    put(ML::RAD_J, radius[c.j]);
+    put(ML::REFF, reff);
+    put(ML::ASEP, c.scales.scales.asep);
+    put(ML::FC, c.scales.scales.fc);
+    put(ML::SQRT_KN_SEP, c.scales.scales.sqrt_kn_sep);
+    put(ML::MASS_FACTOR, fm.mass_factor);
     put(ML::ALPHA, fm.alpha);
     put(ML::K_T, fm.k_t);
     put(ML::MU, fm.mu);
-    put(ML::DT, model_dt[model]);
+    put(ML::DT, model_dt[c.model]);
     put(ML::XI_CRIT, fm.rolling ? fm.theta_crit * (fm.roll_radius_factor * reff) : 0.0);
     put(ML::ROLLING, fm.rolling ? 1.0 : 0.0);
     put(ML::TWISTING, fm.twisting ? 1.0 : 0.0);
     put(ML::HERTZ, fm.gamma == 0.0 ? 1.0 : 0.0);
     put(ML::EMIX, fm.emix);
+  };
+  auto gather_contact = [&](const Contact &c, double s, double *in, int stride) {
+    gather_own(c, s, in, stride);
+    gather_shared(c, in, stride);
   };
   // the results of one contact back: its histories (the sub-models it has), then forces and
   // torques through scatter(); input and output q at in[q * stride], out[q * stride]
@@ -589,6 +597,17 @@ void PairGranularOpt::compute_fused_contacts()
 
   model_dt.resize(nmodels);
   for (int m = 0; m < nmodels; m++) model_dt[m] = models_list[m]->dt;
+  // every contact of one model and one type pair whose atoms have one radius each (a
+  // monodisperse packing of one type): the shared inputs are written into every lane once
+  const int *type = atom->type;
+  bool one_pair = n > 0;
+  for (std::size_t k = 0; k < n && one_pair; k++) {
+    const Contact &c = contacts[k];
+    one_pair = c.model == contacts[0].model && c.scales.valid &&
+        type[c.i] == type[contacts[0].i] && type[c.j] == type[contacts[0].j];
+  }
+  if (one_pair)
+    for (int l = 0; l < static_cast<int>(CHUNK); l++) gather_shared(contacts[0], lane_input(l), W);
   std::size_t next_root = 0;
   for (std::size_t start = 0; start < n; start += CHUNK) {
     const std::size_t m = std::min(CHUNK, n - start);
@@ -608,7 +627,10 @@ void PairGranularOpt::compute_fused_contacts()
         continue;
       }
       lane_of[k] = nlanes;
-      gather_contact(c, jkr_root[next_root++], lane_input(nlanes), W);
+      if (one_pair)
+        gather_own(c, jkr_root[next_root++], lane_input(nlanes), W);
+      else
+        gather_contact(c, jkr_root[next_root++], lane_input(nlanes), W);
       nlanes++;
     }
     // a short last block: its other lanes evaluate copies of its first contact, not scattered
