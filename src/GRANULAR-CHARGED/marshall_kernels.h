@@ -27,8 +27,10 @@
 // call would leave its instruction set and pass vectors through memory)
 #if defined(__GNUC__)
 #define GC_KERNEL_INLINE inline __attribute__((always_inline))
+#define GC_KERNEL_LAMBDA __attribute__((always_inline))
 #else
 #define GC_KERNEL_INLINE inline
+#define GC_KERNEL_LAMBDA
 #endif
 
 namespace LAMMPS_NS {
@@ -101,6 +103,12 @@ namespace MarshallKernels {
   template <> struct NumberOps<double> {
     using Mask = bool;
     static GC_KERNEL_INLINE double select(bool c, double a, double b) { return c ? a : b; }
+    // a value used only where c holds (under select(c, ...)): one contact computes it only
+    // then, lanes compute it in every lane
+    template <class F> static GC_KERNEL_INLINE double only_where(bool c, F value)
+    {
+      return c ? value() : 0.0;
+    }
     static GC_KERNEL_INLINE double sqrt(double x) { return std::sqrt(x); }
     static GC_KERNEL_INLINE double abs(double x) { return std::fabs(x); }
   };
@@ -239,7 +247,9 @@ namespace MarshallKernels {
     T p[3];
     for (int k = 0; k < 3; k++) p[k] = v[k] - vn * n[k];
     const T plensq = lensq3(p);
-    const T rescale = N::select(plensq > 0.0, N::sqrt(lensq / plensq), T{});
+    const T rescale = N::only_where(rotate, [&]() GC_KERNEL_LAMBDA {
+      return N::select(plensq > 0.0, N::sqrt(lensq / plensq), T{});
+    });
     for (int k = 0; k < 3; k++) v[k] = N::select(rotate, p[k] * rescale, v[k]);
   }
 
@@ -264,8 +274,9 @@ namespace MarshallKernels {
     const T magfs_sq = lensq3(fs);
     const auto slip = magfs_sq > fscrit * fscrit;
     const auto spring = lensq3(history) != 0.0;
-    const T ratio = fscrit / N::sqrt(magfs_sq);
-    const T inv_k = -1.0 / k_scaled;
+    const T ratio =
+        N::only_where(slip, [&]() GC_KERNEL_LAMBDA { return fscrit / N::sqrt(magfs_sq); });
+    const T inv_k = N::only_where(slip, [&]() GC_KERNEL_LAMBDA { return -1.0 / k_scaled; });
     for (int k = 0; k < 3; k++) {
       const T fslip = N::select(spring, fs[k] * ratio, T{});
       const T hslip = inv_k * (fslip - fdamp[k]);
@@ -296,7 +307,8 @@ namespace MarshallKernels {
     // irreversible rolling beyond theta_crit R
     const T lensq = lensq3(xi);
     const auto capped = lensq > xi_crit * xi_crit;
-    const T ratio = xi_crit / N::sqrt(lensq);
+    const T ratio =
+        N::only_where(capped, [&]() GC_KERNEL_LAMBDA { return xi_crit / N::sqrt(lensq); });
     for (int k = 0; k < 3; k++) xi[k] = N::select(capped, ratio * xi[k], xi[k]);
 
     for (int k = 0; k < 3; k++) fr[k] = -k_over_reff * xi[k];
@@ -327,7 +339,9 @@ namespace MarshallKernels {
     const T trial = -k * angle - damp * magtwist;
     const auto slip = N::abs(trial) > mcrit;
     const T limited = N::select(trial > 0.0, mcrit, -mcrit);
-    const T slip_angle = N::select(k > 0.0, -(limited + damp * magtwist) / k, T{});
+    const T slip_angle = N::only_where(slip, [&]() GC_KERNEL_LAMBDA {
+      return N::select(k > 0.0, -(limited + damp * magtwist) / k, T{});
+    });
     if (history_update) phi = N::select(slip, slip_angle, angle);
     return N::select(slip, limited, trial);
   }

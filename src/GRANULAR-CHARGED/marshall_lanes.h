@@ -53,6 +53,7 @@ namespace MarshallKernels {
     using T = MarshallLanes::Lanes;
     using Mask = MarshallLanes::LaneMask;
     static GC_KERNEL_INLINE T select(Mask c, T a, T b) { return c ? a : b; }
+    template <class F> static GC_KERNEL_INLINE T only_where(Mask, F value) { return value(); }
     static GC_KERNEL_INLINE T sqrt(T x)
     {
       T r;
