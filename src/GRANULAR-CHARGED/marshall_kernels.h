@@ -9,9 +9,12 @@
 
 // The equations of the Marshall (2009) contact model as stateless inline functions: the one
 // home of each formula, called by the sub-model classes (gran_sub_mod_*_marshall*.cpp, which
-// are the plumbing between LAMMPS's GranularModel and these functions) and by the fused kernel
-// of pair_style granular/opt. Same shape as the gran_sub_mod_*_kernel.h headers of LAMMPS's
-// development branch. Depends only on the header-only MathConst and MathExtra and on jkr_scaled.h.
+// are the plumbing between LAMMPS's GranularModel and these functions), by fix wall/gran/opt
+// and by the fused kernel of pair_style granular/opt (marshall_lanes.h), which evaluates them
+// for one contact (double) or for several in SIMD lanes (the per-contact functions are
+// templates on the number type, below). Same shape as the gran_sub_mod_*_kernel.h headers of
+// LAMMPS's development branch. Depends only on the header-only MathConst and MathExtra and on
+// jkr_scaled.h.
 // Equation numbers: doc/theory.md.
 
 #ifndef LMP_GC_MARSHALL_KERNELS_H

@@ -11,8 +11,9 @@
 // damping, sliding, rolling, twisting, torques) as a template on the number type of
 // marshall_kernels.h: double for one contact (the scalar kernel, the reference), Lanes for
 // WIDTH contacts at once (a GCC vector type, so the vector code needs no auto-vectoriser).
-// Every decision of a contact is a select; the only branches are on history_update, the same
-// for every contact of a step. A contact's inputs and outputs are flat arrays indexed by the
+// Every decision of a contact is a select (the double instantiation computes a value needed on
+// one side only where it is needed: NumberOps::only_where); the only branches of the lanes are
+// on history_update, the same for every contact of a step. A contact's inputs and outputs are flat arrays indexed by the
 // enums below; the lanes kernel reads them as structure-of-arrays blocks, WIDTH contacts of
 // each input next to each other. Free of LAMMPS classes.
 

@@ -280,8 +280,8 @@ void PairGranularOpt::setup_fused()
 /* ----------------------------------------------------------------------
    PairGranular::compute() with the Marshall set fused, as a recipe: set-up, gather (the
    contacts' life decided, the pairs outside the fused set handed to PairGranular::compute on a
-   list of their own), the JKR roots in one batch, the fused kernel with its scatter and the
-   sleepers' bookkeeping per contact. The fused kernel does what GranularModel::check_contact()
+   list of their own), the JKR roots in one batch, the fused kernel in SIMD lanes
+   (marshall_lanes.h), then the scatter and the sleepers' bookkeeping per contact. The fused kernel does what GranularModel::check_contact()
    and calculate_forces() do with the Marshall sub-models, in the same order of operations,
    skipping what the set does not use (relative tangential speed, heat, classic torque scaling).
    The history of a pair is the same array at the same offsets, so fix neigh/history, restarts

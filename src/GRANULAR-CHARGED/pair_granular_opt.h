@@ -27,9 +27,10 @@ namespace LAMMPS_NS {
 
 // pair_style granular with a fused kernel for the Marshall sub-model set (jkr/marshall,
 // damping marshall[/printed], tangential marshall, optional rolling marshall[/particle] and
-// twisting marshall/jkr): one pass per neighbor pair through the inline equations of
-// marshall_kernels.h, no virtual calls. Every other type pair runs PairGranular::compute on a
-// list of those pairs only. Same pair_coeff syntax, history layout, restart and single() as granular
+// twisting marshall/jkr): the touching pairs gathered into SIMD lanes and evaluated several at a
+// time by the inline equations of marshall_kernels.h (marshall_lanes.h), no virtual calls.
+// Every other type pair runs PairGranular::compute on a list of those pairs only. Same
+// pair_coeff syntax, history layout, restart and single() as granular
 // (doc/pair_granular_jkr_marshall.rst, "pair_style granular/opt").
 class PairGranularOpt : public PairGranular {
  public:
