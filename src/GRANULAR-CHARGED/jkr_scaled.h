@@ -41,16 +41,17 @@ namespace JKRScaled {
   // The same root by bisection (slow; for the table and for tests).
   double root_by_bisection(double Delta);
 
-  // adhesive part 4 F_C (a/a_0)^(3/2) over F_C for a root s (doc/theory.md, eq. (1.4a))
-  inline double adhesive_over_fc(double s)
+  // adhesive part 4 F_C (a/a_0)^(3/2) over F_C for a root s (doc/theory.md, eq. (1.4a));
+  // T: double, or the lanes of marshall_lanes.h
+  template <class T> inline __attribute__((always_inline)) T adhesive_over_fc(T s)
   {
     return 2.0 / 3.0 * s * s * s;
   }
 
   // F_ne / F_C for a root s (doc/theory.md, eq. (1.4a)): elastic s^6 / 9 minus the adhesive part
-  inline double force_over_fc(double s)
+  template <class T> inline __attribute__((always_inline)) T force_over_fc(T s)
   {
-    const double s3 = s * s * s;
+    const T s3 = s * s * s;
     return s3 * s3 / 9.0 - adhesive_over_fc(s);
   }
 

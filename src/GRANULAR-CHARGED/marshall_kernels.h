@@ -9,9 +9,12 @@
 
 // The equations of the Marshall (2009) contact model as stateless inline functions: the one
 // home of each formula, called by the sub-model classes (gran_sub_mod_*_marshall*.cpp, which
-// are the plumbing between LAMMPS's GranularModel and these functions) and by the fused kernel
-// of pair_style granular/opt. Same shape as the gran_sub_mod_*_kernel.h headers of LAMMPS's
-// development branch. Depends only on the header-only MathConst and MathExtra and on jkr_scaled.h.
+// are the plumbing between LAMMPS's GranularModel and these functions), by fix wall/gran/opt
+// and by the fused kernel of pair_style granular/opt (marshall_lanes.h), which evaluates them
+// for one contact (double) or for several in SIMD lanes (the per-contact functions are
+// templates on the number type, below). Same shape as the gran_sub_mod_*_kernel.h headers of
+// LAMMPS's development branch. Depends only on the header-only MathConst and MathExtra and on
+// jkr_scaled.h.
 // Equation numbers: doc/theory.md.
 
 #ifndef LMP_GC_MARSHALL_KERNELS_H
@@ -22,6 +25,16 @@
 #include "math_extra.h"
 
 #include <cmath>
+
+// the templates below are inlined into each SIMD path's function of marshall_lanes.cpp (a
+// call would leave its instruction set and pass vectors through memory)
+#if defined(__GNUC__)
+#define GC_KERNEL_INLINE inline __attribute__((always_inline))
+#define GC_KERNEL_LAMBDA __attribute__((always_inline))
+#else
+#define GC_KERNEL_INLINE inline
+#define GC_KERNEL_LAMBDA
+#endif
 
 namespace LAMMPS_NS {
 namespace MarshallKernels {
@@ -80,16 +93,56 @@ namespace MarshallKernels {
   }
 
   /* ---------------------------------------------------------------------
+     the number types of the equations below: double (one contact) and the lanes of
+     marshall_lanes.h (several contacts at once, a GCC vector type). The per-contact functions
+     are templates on the number type T and use only + - * / and NumberOps<T>: select() for
+     each decision of a contact (both sides are computed, one is kept), sqrt() and abs(). The
+     IEEE operations are exact in every lane, so the same operation order gives the same bits
+     as the double instantiation, which is the scalar code.
+  --------------------------------------------------------------------- */
+
+  template <class T> struct NumberOps;
+
+  template <> struct NumberOps<double> {
+    using Mask = bool;
+    static GC_KERNEL_INLINE double select(bool c, double a, double b) { return c ? a : b; }
+    // a value used only where c holds (under select(c, ...)): one contact computes it only
+    // then, lanes compute it in every lane
+    template <class F> static GC_KERNEL_INLINE double only_where(bool c, F value)
+    {
+      return c ? value() : 0.0;
+    }
+    static GC_KERNEL_INLINE double sqrt(double x) { return std::sqrt(x); }
+    static GC_KERNEL_INLINE double abs(double x) { return std::fabs(x); }
+  };
+
+  // small vector helpers in MathExtra's operation order (math_extra.h), for every T
+  template <class T> GC_KERNEL_INLINE T dot3(const T *a, const T *b)
+  {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  }
+  template <class T> GC_KERNEL_INLINE T lensq3(const T *v)
+  {
+    return v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+  }
+  template <class T> GC_KERNEL_INLINE void cross3(const T *a, const T *b, T *ans)
+  {
+    ans[0] = a[1] * b[2] - a[2] * b[1];
+    ans[1] = a[2] * b[0] - a[0] * b[2];
+    ans[2] = a[0] * b[1] - a[1] * b[0];
+  }
+  /* ---------------------------------------------------------------------
      normal force
   --------------------------------------------------------------------- */
 
-  struct NormalForce {
-    double a;           // contact radius
-    double fne;         // elastic-adhesive normal force F_ne (positive: repulsive)
-    double adhesive;    // adhesive part 4 F_C (a/a_0)^(3/2), for rolling marshall
-    double pulloff;     // F_C (0 without adhesion)
-    double sqrt_kn;     // sqrt(k_N), k_N = 4/3 E* a: the normal stiffness the damping scales with
+  template <class T> struct NormalForceT {
+    T a;           // contact radius
+    T fne;         // elastic-adhesive normal force F_ne (positive: repulsive)
+    T adhesive;    // adhesive part 4 F_C (a/a_0)^(3/2), for rolling marshall
+    T pulloff;     // F_C (0 without adhesion)
+    T sqrt_kn;     // sqrt(k_N), k_N = 4/3 E* a: the normal stiffness the damping scales with
   };
+  using NormalForce = NormalForceT<double>;
 
   // Delta = delta / delta_C: the overlap of the scaled law (jkr_scaled.h) whose root s gives a
   inline double scaled_overlap(const JKRScales &sc, double delta)
@@ -99,41 +152,52 @@ namespace MarshallKernels {
 
   // JKR contact radius on the stable branch, a = a_sep s^2 with s^4 - 4 s = 3 delta / delta_C
   // (eq. (1.4a); jkr_scaled.h), and F_ne = 4 F_C ((a/a_0)^3 - (a/a_0)^(3/2))
-  // = F_C (s^6 / 9 - 2 s^3 / 3)  (Marshall 2009, eq. 8), from the root s
-  inline NormalForce jkr_normal_force_of_root(const JKRScales &sc, double s)
+  // = F_C (s^6 / 9 - 2 s^3 / 3)  (Marshall 2009, eq. 8), from the root s and the scales
+  // a_sep, F_C, sqrt(4/3 E* a_sep) of JKRScales
+  template <class T>
+  GC_KERNEL_INLINE NormalForceT<T> jkr_normal_force_of_root(T asep, T fc, T sqrt_kn_sep,
+                                                            T s)
   {
-    NormalForce n;
-    n.a = sc.asep * s * s;
-    n.adhesive = JKRScaled::adhesive_over_fc(s) * sc.fc;
-    n.fne = JKRScaled::force_over_fc(s) * sc.fc;
-    n.pulloff = sc.fc;
-    n.sqrt_kn = s * sc.sqrt_kn_sep;
+    NormalForceT<T> n;
+    n.a = asep * s * s;
+    n.adhesive = JKRScaled::adhesive_over_fc(s) * fc;
+    n.fne = JKRScaled::force_over_fc(s) * fc;
+    n.pulloff = fc;
+    n.sqrt_kn = s * sqrt_kn_sep;
     return n;
   }
 
-  // the same from the overlap delta; without adhesion Hertz's law: a = sqrt(delta R),
-  // F_ne = 4 E* a^3 / (3 R)
+  inline NormalForce jkr_normal_force_of_root(const JKRScales &sc, double s)
+  {
+    return jkr_normal_force_of_root(sc.asep, sc.fc, sc.sqrt_kn_sep, s);
+  }
+
+  // without adhesion Hertz's law: a = sqrt(delta R), F_ne = 4 E* a^3 / (3 R)
+  inline NormalForce hertz_normal_force(double emix, double delta, double reff)
+  {
+    NormalForce n;
+    const double dR = delta * reff;
+    n.a = sqrt(dR > 0.0 ? dR : 0.0);
+    n.fne = 4.0 / 3.0 * emix * n.a * n.a * n.a / reff;
+    n.adhesive = 0.0;
+    n.pulloff = 0.0;
+    n.sqrt_kn = sqrt(4.0 / 3.0 * emix * n.a);
+    return n;
+  }
+
+  // the same from the overlap delta (Hertz's law without adhesion)
   inline NormalForce jkr_normal_force(const JKRScales &sc, double gamma, double emix,
                                       double delta, double reff)
   {
-    if (gamma == 0.0) {
-      NormalForce n;
-      const double dR = delta * reff;
-      n.a = sqrt(dR > 0.0 ? dR : 0.0);
-      n.fne = 4.0 / 3.0 * emix * n.a * n.a * n.a / reff;
-      n.adhesive = 0.0;
-      n.pulloff = 0.0;
-      n.sqrt_kn = sqrt(4.0 / 3.0 * emix * n.a);
-      return n;
-    }
+    if (gamma == 0.0) return hertz_normal_force(emix, delta, reff);
     return jkr_normal_force_of_root(sc, JKRScaled::root(scaled_overlap(sc, delta)));
   }
 
   // F_crit = |F_ne + 2 F_C|: the normal load the friction limits scale with (paper eq. 4;
   // LAMMPS's GranSubModNormalJKR::set_fncrit)
-  inline double critical_force(const NormalForce &n)
+  template <class T> GC_KERNEL_INLINE T critical_force(const NormalForceT<T> &n)
   {
-    return fabs(n.fne + 2.0 * n.pulloff);
+    return NumberOps<T>::abs(n.fne + 2.0 * n.pulloff);
   }
 
   /* ---------------------------------------------------------------------
@@ -152,14 +216,15 @@ namespace MarshallKernels {
   }
 
   // sqrt(mass_factor m*): the mass part of eta_N, a constant of a pair of particles
-  inline double damping_sqrt_mass(double mass_factor, double meff)
+  template <class T> GC_KERNEL_INLINE T damping_sqrt_mass(T mass_factor, T meff)
   {
-    return sqrt(mass_factor * meff);
+    return NumberOps<T>::sqrt(mass_factor * meff);
   }
 
   // eta_N = alpha sqrt(mass_factor m*) sqrt(k_N); a >= 0.30285 a_0 > 0 for every live JKR
   // contact, so k_N > 0 also in tension
-  inline double damping_prefactor(double alpha, double sqrt_mass, const NormalForce &n)
+  template <class T>
+  GC_KERNEL_INLINE T damping_prefactor(T alpha, T sqrt_mass, const NormalForceT<T> &n)
   {
     return alpha * sqrt_mass * n.sqrt_kn;
   }
@@ -175,42 +240,51 @@ namespace MarshallKernels {
   --------------------------------------------------------------------- */
 
   // v -= (v . n) n, then restore |v| (as LAMMPS's GranSubMod::rotate_rescale_vec, with one
-  // square root): the history of a contact follows the rotation of its tangent plane
-  inline void rotate_into_plane(double *v, const double *n, double vn)
+  // square root) where `rotate` holds: the history of a contact follows the rotation of its
+  // tangent plane
+  template <class T, class M>
+  GC_KERNEL_INLINE void rotate_into_plane(T *v, const T *n, T vn, M rotate)
   {
-    const double lensq = MathExtra::lensq3(v);
-    double along[3];
-    MathExtra::scale3(vn, n, along);
-    MathExtra::sub3(v, along, v);
-    const double plensq = MathExtra::lensq3(v);
-    MathExtra::scale3(plensq > 0.0 ? sqrt(lensq / plensq) : 0.0, v);
+    using N = NumberOps<T>;
+    const T lensq = lensq3(v);
+    T p[3];
+    for (int k = 0; k < 3; k++) p[k] = v[k] - vn * n[k];
+    const T plensq = lensq3(p);
+    const T rescale = N::only_where(rotate, [&]() GC_KERNEL_LAMBDA {
+      return N::select(plensq > 0.0, N::sqrt(lensq / plensq), T{});
+    });
+    for (int k = 0; k < 3; k++) v[k] = N::select(rotate, p[k] * rescale, v[k]);
   }
 
-  inline void tangential_force(double *history, const double *nx, const double *vtr, double dt,
-                               double k_scaled, double damp, double fscrit, bool history_update,
-                               double *fs)
+  template <class T>
+  GC_KERNEL_INLINE void tangential_force(T *history, const T *nx, const T *vtr, T dt,
+                                         T k_scaled, T damp, T fscrit, bool history_update,
+                                         T *fs)
   {
+    using N = NumberOps<T>;
     if (history_update) {
-      const double rsht = MathExtra::dot3(history, nx);
-      if ((fabs(rsht) * k_scaled) > (FRAME_EPSILON * fscrit)) rotate_into_plane(history, nx, rsht);
-      double increment[3];
-      MathExtra::scale3(dt, vtr, increment);
-      MathExtra::add3(history, increment, history);
+      const T rsht = dot3(history, nx);
+      rotate_into_plane(history, nx, rsht, (N::abs(rsht) * k_scaled) > (FRAME_EPSILON * fscrit));
+      for (int k = 0; k < 3; k++) history[k] = history[k] + dt * vtr[k];
     }
-    double fdamp[3];
-    MathExtra::scale3(-k_scaled, history, fs);
-    MathExtra::scale3(-damp, vtr, fdamp);
-    MathExtra::add3(fs, fdamp, fs);
+    T fdamp[3];
+    for (int k = 0; k < 3; k++) {
+      fdamp[k] = -damp * vtr[k];
+      fs[k] = -k_scaled * history[k] + fdamp[k];
+    }
 
-    const double magfs_sq = MathExtra::lensq3(fs);
-    if (magfs_sq > fscrit * fscrit) {
-      if (MathExtra::lensq3(history) != 0.0) {
-        MathExtra::scale3(fscrit / sqrt(magfs_sq), fs);
-        MathExtra::sub3(fs, fdamp, history);
-        MathExtra::scale3(-1.0 / k_scaled, history);
-      } else {
-        MathExtra::zero3(fs);
-      }
+    // slip: F_t scaled to mu F_crit and h reset to its elastic part (F_t = 0 without a spring)
+    const T magfs_sq = lensq3(fs);
+    const auto slip = magfs_sq > fscrit * fscrit;
+    const auto spring = lensq3(history) != 0.0;
+    const T ratio =
+        N::only_where(slip, [&]() GC_KERNEL_LAMBDA { return fscrit / N::sqrt(magfs_sq); });
+    const T inv_k = N::only_where(slip, [&]() GC_KERNEL_LAMBDA { return -1.0 / k_scaled; });
+    for (int k = 0; k < 3; k++) {
+      const T fslip = N::select(spring, fs[k] * ratio, T{});
+      const T hslip = inv_k * (fslip - fdamp[k]);
+      history[k] = N::select(slip, N::select(spring, hslip, history[k]), history[k]);
+      fs[k] = N::select(slip, fslip, fs[k]);
     }
   }
 
@@ -222,23 +296,27 @@ namespace MarshallKernels {
      GranularModel applies torque_i += R n x fr, hence fr = -(k_R / R) xi.
   --------------------------------------------------------------------- */
 
-  inline void rolling_force(double *history, const double *nx, const double *vrl, double dt,
-                            double xi_crit, double k_over_reff, bool history_update, double *fr)
+  template <class T>
+  GC_KERNEL_INLINE void rolling_force(T *history, const T *nx, const T *vrl, T dt, T xi_crit,
+                            T k_over_reff, bool history_update, T *fr)
   {
-    double xi[3], tmp[3];
-    MathExtra::copy3(history, xi);
+    using N = NumberOps<T>;
+    T xi[3] = {history[0], history[1], history[2]};
     if (history_update) {
-      const double xin = MathExtra::dot3(xi, nx);
-      if (xin != 0.0) rotate_into_plane(xi, nx, xin);
-      MathExtra::scale3(dt, vrl, tmp);
-      MathExtra::add3(xi, tmp, xi);
+      const T xin = dot3(xi, nx);
+      rotate_into_plane(xi, nx, xin, xin != 0.0);
+      for (int k = 0; k < 3; k++) xi[k] = xi[k] + dt * vrl[k];
     }
     // irreversible rolling beyond theta_crit R
-    const double lensq = MathExtra::lensq3(xi);
-    if (lensq > xi_crit * xi_crit) MathExtra::scale3(xi_crit / sqrt(lensq), xi);
+    const T lensq = lensq3(xi);
+    const auto capped = lensq > xi_crit * xi_crit;
+    const T ratio =
+        N::only_where(capped, [&]() GC_KERNEL_LAMBDA { return xi_crit / N::sqrt(lensq); });
+    for (int k = 0; k < 3; k++) xi[k] = N::select(capped, ratio * xi[k], xi[k]);
 
-    MathExtra::scale3(-k_over_reff, xi, fr);
-    if (history_update) MathExtra::copy3(xi, history);
+    for (int k = 0; k < 3; k++) fr[k] = -k_over_reff * xi[k];
+    if (history_update)
+      for (int k = 0; k < 3; k++) history[k] = xi[k];
   }
 
   /* ---------------------------------------------------------------------
@@ -249,23 +327,26 @@ namespace MarshallKernels {
      Arguments: k_t = 8 G* (per unit contact radius), eta_t = eta_N, mu_fcrit = mu F_crit.
   --------------------------------------------------------------------- */
 
-  inline double twisting_moment(double &phi, double magtwist, double dt, double a, double k_t,
-                                double eta_t, double mu_fcrit, bool history_update)
+  template <class T>
+  GC_KERNEL_INLINE T twisting_moment(T &phi, T magtwist, T dt, T a, T k_t, T eta_t, T mu_fcrit,
+                           bool history_update)
   {
-    const double k = 0.5 * k_t * a * a * a;
-    const double damp = 0.5 * eta_t * a * a;
-    const double mcrit = THREEPI_16 * a * mu_fcrit;
+    using N = NumberOps<T>;
+    const T k = 0.5 * k_t * a * a * a;
+    const T damp = 0.5 * eta_t * a * a;
+    const T mcrit = THREEPI_16 * a * mu_fcrit;
 
-    double angle = phi;
-    if (history_update) angle += magtwist * dt;
+    T angle = phi;
+    if (history_update) angle = angle + magtwist * dt;
 
-    double moment = -k * angle - damp * magtwist;
-    if (fabs(moment) > mcrit) {
-      moment = (moment > 0.0) ? mcrit : -mcrit;
-      angle = (k > 0.0) ? -(moment + damp * magtwist) / k : 0.0;
-    }
-    if (history_update) phi = angle;
-    return moment;
+    const T trial = -k * angle - damp * magtwist;
+    const auto slip = N::abs(trial) > mcrit;
+    const T limited = N::select(trial > 0.0, mcrit, -mcrit);
+    const T slip_angle = N::only_where(slip, [&]() GC_KERNEL_LAMBDA {
+      return N::select(k > 0.0, -(limited + damp * magtwist) / k, T{});
+    });
+    if (history_update) phi = N::select(slip, slip_angle, angle);
+    return N::select(slip, limited, trial);
   }
 
 }    // namespace MarshallKernels

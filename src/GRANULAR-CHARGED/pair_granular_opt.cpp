@@ -9,6 +9,8 @@
 
 #include "pair_granular_opt.h"
 
+#include "marshall_lanes.h"
+
 #include "atom.h"
 #include "comm.h"
 #include "error.h"
@@ -34,6 +36,7 @@ using namespace LAMMPS_NS;
 using namespace Granular_NS;
 using namespace MathExtra;
 namespace MK = MarshallKernels;
+namespace ML = MarshallLanes;
 
 /* ---------------------------------------------------------------------- */
 
@@ -277,8 +280,8 @@ void PairGranularOpt::setup_fused()
 /* ----------------------------------------------------------------------
    PairGranular::compute() with the Marshall set fused, as a recipe: set-up, gather (the
    contacts' life decided, the pairs outside the fused set handed to PairGranular::compute on a
-   list of their own), the JKR roots in one batch, the fused kernel with its scatter and the
-   sleepers' bookkeeping per contact. The fused kernel does what GranularModel::check_contact()
+   list of their own), the JKR roots in one batch, the fused kernel in SIMD lanes
+   (marshall_lanes.h), then the scatter and the sleepers' bookkeeping per contact. The fused kernel does what GranularModel::check_contact()
    and calculate_forces() do with the Marshall sub-models, in the same order of operations,
    skipping what the set does not use (relative tangential speed, heat, classic torque scaling).
    The history of a pair is the same array at the same offsets, so fix neigh/history, restarts
@@ -397,9 +400,11 @@ void PairGranularOpt::gather_contacts()
     const int jnum = list->numneigh[i];
     for (int jj = 0; jj < jnum; jj++) {
       const int j = jlist[jj] & NEIGHMASK;
-      if (special_lj[sbmask(jlist[jj])] == 0) continue;
+      const double factor_lj = special_lj[sbmask(jlist[jj])];
+      if (factor_lj == 0) continue;
       if (asleep && asleep[i] != 0.0 && asleep[j] != 0.0) continue;
-      const FusedMarshall &fm = fused[types_indices[type[i]][type[j]]];
+      const int model = types_indices[type[i]][type[j]];
+      const FusedMarshall &fm = fused[model];
       if (!fm.on) {
         generic_i.push_back(i);
         generic_jj.push_back(jj);
@@ -422,7 +427,7 @@ void PairGranularOpt::gather_contacts()
       touch[jj] = 1;
       if (fm.gamma != 0.0)
         jkr_overlap.push_back(MK::scaled_overlap(ps.scales, radsum - sqrt(rsq)));
-      contacts.push_back({i, jj, ps});
+      contacts.push_back({i, jj, j, model, factor_lj, ps});
     }
   }
 }
@@ -493,123 +498,167 @@ bigint PairGranularOpt::compute_generic_pairs(int eflag, int vflag)
 }
 
 /* ----------------------------------------------------------------------
-   the fused contacts in list order: kernel, scatter, the sleepers' bookkeeping
+   the fused contacts in list order, a chunk at a time (its lanes blocks stay in the L1
+   cache): the adhesive contacts gathered into lanes blocks and evaluated by the lanes kernel
+   (marshall_lanes.h) on the default SIMD path, the others (no adhesion: Hertz's law) by the
+   scalar instantiation of the same kernel; then scatter and the sleepers' bookkeeping per
+   contact in list order, so the sums over contacts are those of a scalar loop
 ------------------------------------------------------------------------- */
 
 void PairGranularOpt::compute_fused_contacts()
 {
-  double *special_lj = force->special_lj;
-  std::size_t next_root = 0;
-  for (const Contact &c : contacts) {
-    int j = list->firstneigh[c.i][c.jj];
-    const double factor_lj = special_lj[sbmask(j)];
-    j &= NEIGHMASK;
-    PairForces pf;
-    fused_contact(c, j, next_root, pf);
-    scatter(c.i, j, factor_lj, pf);
-  }
-}
+  constexpr int W = ML::WIDTH;
+  constexpr std::size_t CHUNK = 8 * W;
+  constexpr std::size_t PREFETCH = 4;
+  const std::size_t n = contacts.size();
+  lane_in.resize(CHUNK * ML::N_INPUT);
+  lane_out.resize(CHUNK * ML::N_OUTPUT);
+  lane_of.resize(CHUNK);
+  // lane l's first input and output: block l / W, offset l % W, WIDTH apart
+  auto lane_input = [&](int l) { return &lane_in[(l / W) * ML::N_INPUT * W + l % W]; };
+  auto lane_output = [&](int l) { return &lane_out[(l / W) * ML::N_OUTPUT * W + l % W]; };
 
-/* ----------------------------------------------------------------------
-   the fused kernel for one contact (GranularModel::calculate_forces with the Marshall set)
-------------------------------------------------------------------------- */
-
-void PairGranularOpt::fused_contact(const Contact &c, int j, std::size_t &next_root,
-                                    PairForces &pf)
-{
-  const int i = c.i;
-  const FusedMarshall &fm = fused[types_indices[atom->type[i]][atom->type[j]]];
   double **x = atom->x, **v = atom->v, **omega = atom->omega;
-  const double radi = atom->radius[i], radj = atom->radius[j];
-  const double reff = c.scales.reff;
-  double *history = &fix_history->firstvalue[i][get_size_history() * c.jj];
-  const double dt = models_list[types_indices[atom->type[i]][atom->type[j]]]->dt;
-
-  double *dx = pf.dx;
-  sub3(x[i], x[j], dx);
-  const double rsq = lensq3(dx);
-  const double sqrt_mass = MK::damping_sqrt_mass(fm.mass_factor, effective_mass(i, j));
-
-  // kinematics (GranularModel::calculate_forces)
-  const double r = sqrt(rsq);
-  const double rinv = 1.0 / r;
-  const double delta = radi + radj - r;
-  double vr[3], nx[3], vn[3], vt[3], wr[3], temp[3], vtr[3];
-  sub3(v[i], v[j], vr);
-  scale3(rinv, dx, nx);
-  const double vnnr = dot3(vr, nx);
-  scale3(vnnr, nx, vn);
-  sub3(vr, vn, vt);
-  scaleadd3(radi, omega[i], radj, omega[j], wr);
-  cross3(wr, nx, temp);
-  sub3(vt, temp, vtr);
-
-  // normal: JKR with Marshall damping (the root from the batch)
-  const MK::NormalForce nf = (fm.gamma != 0.0)
-      ? MK::jkr_normal_force_of_root(c.scales.scales, jkr_root[next_root++])
-      : MK::jkr_normal_force(c.scales.scales, fm.gamma, fm.emix, delta, reff);
-  const double damp_prefactor = MK::damping_prefactor(fm.alpha, sqrt_mass, nf);
-  const double fntot = nf.fne + (-damp_prefactor * vnnr);
-  const double fncrit = MK::critical_force(nf);
-
-  // sliding
-  double fs[3];
-  MK::tangential_force(&history[hist_tangential], nx, vtr, dt, fm.k_t * nf.a, damp_prefactor,
-                       fncrit * fm.mu, history_update, fs);
-
-  scale3(fntot, nx, pf.forces);
-  add3(pf.forces, fs, pf.forces);
-  cross3(nx, fs, pf.torquesi);
-  scale3(-1, pf.torquesi);
-  copy3(pf.torquesi, pf.torquesj);
-  scale3(radi - 0.5 * delta, pf.torquesi);
-  scale3(radj - 0.5 * delta, pf.torquesj);
-
-  if (!fm.rolling && !fm.twisting) return;
-  double relrot[3];
-  sub3(omega[i], omega[j], relrot);
-  if (fm.rolling) {
-    // rolling velocity, eq. 31 of Wang et al, Particuology 23, 49 (2015)
-    double vrl[3], fr[3], torroll[3];
-    vrl[0] = reff * (relrot[1] * nx[2] - relrot[2] * nx[1]);
-    vrl[1] = reff * (relrot[2] * nx[0] - relrot[0] * nx[2]);
-    vrl[2] = reff * (relrot[0] * nx[1] - relrot[1] * nx[0]);
-    MK::rolling_force(&history[hist_rolling], nx, vrl, dt,
-                      fm.theta_crit * (fm.roll_radius_factor * reff), nf.adhesive / reff,
-                      history_update, fr);
-    cross3(nx, fr, torroll);
-    scale3(reff, torroll);
-    add3(pf.torquesi, torroll, pf.torquesi);
-    sub3(pf.torquesj, torroll, pf.torquesj);
-  }
-  if (fm.twisting) {
-    // omega_T (eq. 29 of Marshall 2009)
-    const double magtwist = dot3(relrot, nx);
-    const double moment = MK::twisting_moment(history[hist_twisting], magtwist, dt, nf.a, fm.k_t,
-                                              damp_prefactor, fm.mu * fncrit, history_update);
-    double tortwist[3];
-    scale3(moment, nx, tortwist);
-    add3(pf.torquesi, tortwist, pf.torquesi);
-    sub3(pf.torquesj, tortwist, pf.torquesj);
-  }
-}
-
-/* ----------------------------------------------------------------------
-   m* of pair i, j; a frozen atom (fix freeze) or a sleeper is a fixed body: the other's mass
-------------------------------------------------------------------------- */
-
-double PairGranularOpt::effective_mass(int i, int j) const
-{
-  const double mi = atom->rmass[i], mj = atom->rmass[j];
-  double meff = mi * mj / (mi + mj);
+  const double *radius = atom->radius, *rmass = atom->rmass;
   const int *mask = atom->mask;
-  if (mask[i] & freeze_group_bit) meff = mj;
-  if (mask[j] & freeze_group_bit) meff = mi;
-  if (sleep.asleep) {
-    if (sleep.asleep[i] != 0.0) meff = mj;
-    if (sleep.asleep[j] != 0.0) meff = mi;
+  const double *asleep = sleep.asleep;
+  double **allhistory = fix_history->firstvalue;
+  const int size_hist = get_size_history();
+  // the inputs of one contact (marshall_lanes.h), input q at in[q * stride], in two parts: those
+  // of the contact's atoms and history (s: its JKR root, unused without adhesion) and those of
+  // its model and type pair, the same for every contact of one type pair of one radius each
+  auto gather_own = [&](const Contact &c, double s, double *in, int stride) {
+    const int i = c.i, j = c.j;
+    const FusedMarshall &fm = fused[c.model];
+    const double *history = &allhistory[i][size_hist * c.jj];
+    auto put = [in, stride](int q, double value) { in[q * stride] = value; };
+    for (int k = 0; k < 3; k++) {
+      put(ML::DX + k, x[i][k] - x[j][k]);
+      put(ML::VR + k, v[i][k] - v[j][k]);
+      put(ML::OMEGA_I + k, omega[i][k]);
+      put(ML::OMEGA_J + k, omega[j][k]);
+      put(ML::HIST_T + k, history[hist_tangential + k]);
+      put(ML::HIST_R + k, fm.rolling ? history[hist_rolling + k] : 0.0);
+    }
+    put(ML::HIST_TW, fm.twisting ? history[hist_twisting] : 0.0);
+    put(ML::ROOT, s);
+    put(ML::MASS_I, rmass[i]);
+    put(ML::MASS_J, rmass[j]);
+    // a frozen atom or a sleeper is a fixed body, in this order of precedence
+    double fixed = ML::FIXED_NONE;
+    if (mask[i] & freeze_group_bit) fixed = ML::FIXED_I;
+    if (mask[j] & freeze_group_bit) fixed = ML::FIXED_J;
+    if (asleep && asleep[i] != 0.0) fixed = ML::FIXED_I;
+    if (asleep && asleep[j] != 0.0) fixed = ML::FIXED_J;
+    put(ML::FIXED, fixed);
+  };
+  auto gather_shared = [&](const Contact &c, double *in, int stride) {
+    const FusedMarshall &fm = fused[c.model];
+    const double reff = c.scales.reff;
+    auto put = [in, stride](int q, double value) { in[q * stride] = value; };
+    put(ML::RAD_I, radius[c.i]);
+    put(ML::RAD_J, radius[c.j]);
+    put(ML::REFF, reff);
+    put(ML::ASEP, c.scales.scales.asep);
+    put(ML::FC, c.scales.scales.fc);
+    put(ML::SQRT_KN_SEP, c.scales.scales.sqrt_kn_sep);
+    put(ML::MASS_FACTOR, fm.mass_factor);
+    put(ML::ALPHA, fm.alpha);
+    put(ML::K_T, fm.k_t);
+    put(ML::MU, fm.mu);
+    put(ML::DT, model_dt[c.model]);
+    put(ML::XI_CRIT, fm.rolling ? fm.theta_crit * (fm.roll_radius_factor * reff) : 0.0);
+    put(ML::ROLLING, fm.rolling ? 1.0 : 0.0);
+    put(ML::TWISTING, fm.twisting ? 1.0 : 0.0);
+    put(ML::HERTZ, fm.gamma == 0.0 ? 1.0 : 0.0);
+    put(ML::EMIX, fm.emix);
+  };
+  auto gather_contact = [&](const Contact &c, double s, double *in, int stride) {
+    gather_own(c, s, in, stride);
+    gather_shared(c, in, stride);
+  };
+  // the results of one contact back: its histories (the sub-models it has), then forces and
+  // torques through scatter(); input and output q at in[q * stride], out[q * stride]
+  auto scatter_contact = [&](const Contact &c, const double *in, const double *out, int stride) {
+    const FusedMarshall &fm = fused[c.model];
+    double *history = &allhistory[c.i][size_hist * c.jj];
+    PairForces pf;
+    for (int k = 0; k < 3; k++) {
+      history[hist_tangential + k] = out[(ML::OUT_HIST_T + k) * stride];
+      if (fm.rolling) history[hist_rolling + k] = out[(ML::OUT_HIST_R + k) * stride];
+      pf.forces[k] = out[(ML::FORCE + k) * stride];
+      pf.torquesi[k] = out[(ML::TORQUE_I + k) * stride];
+      pf.torquesj[k] = out[(ML::TORQUE_J + k) * stride];
+      pf.dx[k] = in[(ML::DX + k) * stride];
+    }
+    if (fm.twisting) history[hist_twisting] = out[ML::OUT_HIST_TW * stride];
+    scatter(c.i, c.j, c.factor_lj, pf);
+  };
+
+  model_dt.resize(nmodels);
+  for (int m = 0; m < nmodels; m++) model_dt[m] = models_list[m]->dt;
+  // every contact of one model and one type pair whose atoms have one radius each (a
+  // monodisperse packing of one type): the shared inputs are written into every lane once
+  const int *type = atom->type;
+  bool one_pair = n > 0;
+  for (std::size_t k = 0; k < n && one_pair; k++) {
+    const Contact &c = contacts[k];
+    one_pair = c.model == contacts[0].model && c.scales.valid &&
+        type[c.i] == type[contacts[0].i] && type[c.j] == type[contacts[0].j];
   }
-  return meff;
+  if (one_pair)
+    for (int l = 0; l < static_cast<int>(CHUNK); l++) gather_shared(contacts[0], lane_input(l), W);
+  std::size_t next_root = 0;
+  for (std::size_t start = 0; start < n; start += CHUNK) {
+    const std::size_t m = std::min(CHUNK, n - start);
+    int nlanes = 0;
+    for (std::size_t k = 0; k < m; k++) {
+      const Contact &c = contacts[start + k];
+      // the neighbor's data a few contacts ahead: each contact's loads then overlap with the
+      // gathering of the previous ones
+      if (start + k + PREFETCH < n) {
+        const int jn = contacts[start + k + PREFETCH].j;
+        __builtin_prefetch(x[jn]);
+        __builtin_prefetch(v[jn]);
+        __builtin_prefetch(omega[jn]);
+      }
+      if (fused[c.model].gamma == 0.0) {
+        lane_of[k] = -1;
+        continue;
+      }
+      lane_of[k] = nlanes;
+      if (one_pair)
+        gather_own(c, jkr_root[next_root++], lane_input(nlanes), W);
+      else
+        gather_contact(c, jkr_root[next_root++], lane_input(nlanes), W);
+      nlanes++;
+    }
+    // a short last block: its other lanes evaluate copies of its first contact, not scattered
+    const int nblocks = (nlanes + W - 1) / W;
+    for (int l = nlanes; l < nblocks * W; l++) {
+      const double *first = lane_input(l - l % W);
+      double *pad = lane_input(l);
+      for (int q = 0; q < ML::N_INPUT; q++) pad[q * W] = first[q * W];
+    }
+    ML::contacts_in_lanes(nblocks, lane_in.data(), lane_out.data(), history_update);
+
+    for (std::size_t k = 0; k < m; k++) {
+      const Contact &c = contacts[start + k];
+      if (k + PREFETCH < m) {
+        const int jn = contacts[start + k + PREFETCH].j;
+        __builtin_prefetch(atom->f[jn], 1);
+        __builtin_prefetch(atom->torque[jn], 1);
+      }
+      if (lane_of[k] >= 0) {
+        scatter_contact(c, lane_input(lane_of[k]), lane_output(lane_of[k]), W);
+      } else {
+        double in[ML::N_INPUT], out[ML::N_OUTPUT];
+        gather_contact(c, 1.0, in, 1);
+        ML::marshall_contact(in, out, history_update);
+        scatter_contact(c, in, out, 1);
+      }
+    }
+  }
 }
 
 /* ----------------------------------------------------------------------

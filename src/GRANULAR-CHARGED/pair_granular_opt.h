@@ -27,9 +27,10 @@ namespace LAMMPS_NS {
 
 // pair_style granular with a fused kernel for the Marshall sub-model set (jkr/marshall,
 // damping marshall[/printed], tangential marshall, optional rolling marshall[/particle] and
-// twisting marshall/jkr): one pass per neighbor pair through the inline equations of
-// marshall_kernels.h, no virtual calls. Every other type pair runs PairGranular::compute on a
-// list of those pairs only. Same pair_coeff syntax, history layout, restart and single() as granular
+// twisting marshall/jkr): the touching pairs gathered into SIMD lanes and evaluated several at a
+// time by the inline equations of marshall_kernels.h (marshall_lanes.h), no virtual calls.
+// Every other type pair runs PairGranular::compute on a list of those pairs only. Same
+// pair_coeff syntax, history layout, restart and single() as granular
 // (doc/pair_granular_jkr_marshall.rst, "pair_style granular/opt").
 class PairGranularOpt : public PairGranular {
  public:
@@ -84,13 +85,20 @@ class PairGranularOpt : public PairGranular {
   };
   std::vector<double> type_radius;       // radius of every atom of a type (-1: none)
   std::vector<PairScales> pair_scales;   // per type pair (itype * (ntypes + 1) + jtype)
-  // one fused contact of this compute(): atom, index in its neighbor list, its scales
+  // one fused contact of this compute(): atom, index in its neighbor list, the neighbor, its
+  // model, special factor and scales
   struct Contact {
-    int i, jj;
+    int i, jj, j, model;
+    double factor_lj;
     PairScales scales;
   };
   std::vector<Contact> contacts;
   std::vector<double> jkr_overlap, jkr_root;    // the adhesive contacts' scaled overlaps, roots
+  // lanes blocks of one chunk of contacts (marshall_lanes.h) and each contact's lane (-1: the
+  // scalar kernel)
+  std::vector<double> lane_in, lane_out;
+  std::vector<int> lane_of;
+  std::vector<double> model_dt;          // time step of each model
   struct PairForces {
     double forces[3], torquesi[3], torquesj[3], dx[3];
   };
@@ -116,10 +124,8 @@ class PairGranularOpt : public PairGranular {
   void gather_contacts();
   bigint compute_generic_pairs(int eflag, int vflag);
   void compute_fused_contacts();
-  void fused_contact(const Contact &c, int j, std::size_t &next_root, PairForces &pf);
   void scatter(int i, int j, double factor_lj, PairForces &pf);
   PairScales scales_of(int i, int j, const FusedMarshall &fm) const;
-  double effective_mass(int i, int j) const;
 };
 
 }    // namespace LAMMPS_NS

@@ -27,3 +27,12 @@ add_dependencies(test_granular_opt_switch lmp)
 # fix coul/fmm refuses non-finite charges and unreachable accuracies (one rank: a bad charge
 # stops the rank that owns it)
 gc_lammps_test(test_coul_fmm_input_checks SOURCES test_coul_fmm_input_checks.cpp)
+# the Marshall contacts in SIMD lanes against the scalar kernel on every path the CPU has, and
+# a bed run with GCFMM_SIMD=generic against the default path (separate lmp processes: the path
+# is chosen once per process). Bit for bit, so compiled as marshall_lanes.cpp is.
+gc_lammps_test(test_marshall_lanes SOURCES test_marshall_lanes.cpp)
+target_include_directories(test_marshall_lanes PRIVATE ${CMAKE_SOURCE_DIR}/src/simd/include)
+target_compile_options(test_marshall_lanes PRIVATE ${GCSIMD_BITWISE_OPTIONS} -Wno-psabi)
+target_compile_definitions(test_marshall_lanes PRIVATE GC_LMP_EXECUTABLE="$<TARGET_FILE:lmp>"
+                           GC_SOURCE_DIR="${CMAKE_SOURCE_DIR}")
+add_dependencies(test_marshall_lanes lmp)

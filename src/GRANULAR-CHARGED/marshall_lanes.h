@@ -1,0 +1,236 @@
+/* -*- c++ -*- ----------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   This file is part of the GRANULAR-CHARGED package, distributed under
+   the GNU General Public License (same terms as LAMMPS).
+------------------------------------------------------------------------- */
+
+// One Marshall contact of pair_style granular/opt (kinematics, JKR normal force from its root,
+// damping, sliding, rolling, twisting, torques) as a template on the number type of
+// marshall_kernels.h: double for one contact (the scalar kernel, the reference), Lanes for
+// WIDTH contacts at once (a GCC vector type, so the vector code needs no auto-vectoriser).
+// Every decision of a contact is a select (the double instantiation computes a value needed on
+// one side only where it is needed: NumberOps::only_where); the only branches of the lanes are
+// on history_update, the same for every contact of a step. A contact's inputs and outputs are flat arrays indexed by the
+// enums below; the lanes kernel reads them as structure-of-arrays blocks, WIDTH contacts of
+// each input next to each other. Free of LAMMPS classes.
+
+#ifndef LMP_GC_MARSHALL_LANES_H
+#define LMP_GC_MARSHALL_LANES_H
+
+#include "marshall_kernels.h"
+
+#include <cstddef>
+#include <type_traits>
+
+namespace gcsimd {
+enum class SimdPath;    // gcsimd/simd.hpp: the instruction-set paths
+}
+
+namespace LAMMPS_NS {
+namespace MarshallLanes {
+
+  // contacts per lane vector: one AVX-512 register of doubles, two AVX2 ones, four SSE2 ones
+  constexpr int WIDTH = 8;
+  using Lanes = double __attribute__((vector_size(8 * WIDTH)));
+  using LaneMask = decltype(Lanes{} < Lanes{});
+  // the lanes in the blocks of the buffers: any alignment of a double, and read or written
+  // as doubles elsewhere
+  using LanesInMemory = double
+      __attribute__((vector_size(8 * WIDTH), aligned(alignof(double)), may_alias));
+}    // namespace MarshallLanes
+
+// GCC notes that a 64-byte vector passed by value has another ABI without AVX-512: these
+// functions are always inlined, so no such call exists
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+namespace MarshallKernels {
+  // the lanes as a number type of the equations (marshall_kernels.h). The square root of a
+  // vector is one per lane, which GCC turns into one vector square root (the lanes code is
+  // compiled with -fno-math-errno); abs clears the sign bit, as fabs does.
+  template <> struct NumberOps<MarshallLanes::Lanes> {
+    using T = MarshallLanes::Lanes;
+    using Mask = MarshallLanes::LaneMask;
+    static GC_KERNEL_INLINE T select(Mask c, T a, T b) { return c ? a : b; }
+    template <class F> static GC_KERNEL_INLINE T only_where(Mask, F value) { return value(); }
+    static GC_KERNEL_INLINE T sqrt(T x)
+    {
+      T r;
+      for (int k = 0; k < MarshallLanes::WIDTH; k++) r[k] = __builtin_sqrt(x[k]);
+      return r;
+    }
+    static GC_KERNEL_INLINE T abs(T x)
+    {
+      const Mask magnitude = Mask{} + 0x7fffffffffffffffL;
+      return __builtin_bit_cast(T, __builtin_bit_cast(Mask, x) & magnitude);
+    }
+  };
+}    // namespace MarshallKernels
+#pragma GCC diagnostic pop
+
+namespace MarshallLanes {
+
+  // the inputs of one contact
+  enum Input {
+    DX = 0,              // x_i - x_j (3)
+    VR = 3,              // v_i - v_j (3)
+    OMEGA_I = 6,         // spin of i (3)
+    OMEGA_J = 9,         // spin of j (3)
+    RAD_I = 12,          // radius of i
+    RAD_J,               // radius of j
+    REFF,                // R_eff
+    ROOT,                // root s of the scaled JKR law (jkr_scaled.h) at this overlap
+    ASEP,                // a_sep, F_C, sqrt(4/3 E* a_sep): JKRScales
+    FC,
+    SQRT_KN_SEP,
+    MASS_FACTOR,         // damping marshall 2, marshall/printed 1
+    MASS_I,              // mass of i
+    MASS_J,              // mass of j
+    FIXED,               // FIXED_NONE, FIXED_I or FIXED_J: which one is a fixed body
+    ALPHA,               // damping alpha(e)
+    K_T,                 // 8 G*
+    MU,                  // sliding friction coefficient
+    DT,                  // time step
+    XI_CRIT,             // rolling limit theta_crit R (0 without rolling)
+    ROLLING,             // 1: rolling marshall defined, 0: none
+    TWISTING,            // 1: twisting marshall/jkr defined, 0: none
+    HERTZ,               // 1: no adhesion, Hertz's law (the scalar instantiation only)
+    EMIX,                // E* (for Hertz's law)
+    HIST_T,              // tangential history (3)
+    HIST_R = HIST_T + 3, // rolling history (3)
+    HIST_TW = HIST_R + 3,    // twisting history (1)
+    N_INPUT
+  };
+  // the outputs of one contact: force on i, torques on i and j (before factor_lj), histories
+  enum Output {
+    FORCE = 0,
+    TORQUE_I = 3,
+    TORQUE_J = 6,
+    OUT_HIST_T = 9,
+    OUT_HIST_R = 12,
+    OUT_HIST_TW = 15,
+    N_OUTPUT
+  };
+
+  // a frozen atom (fix freeze) or a sleeper is a fixed body: m* is the other's mass
+  constexpr double FIXED_NONE = 0.0, FIXED_I = 1.0, FIXED_J = 2.0;
+  template <class T> GC_KERNEL_INLINE T effective_mass(T mass_i, T mass_j, T fixed)
+  {
+    using N = MarshallKernels::NumberOps<T>;
+    return N::select(fixed == FIXED_J, mass_i,
+                     N::select(fixed == FIXED_I, mass_j, mass_i * mass_j / (mass_i + mass_j)));
+  }
+
+  /* ---------------------------------------------------------------------
+     GranularModel::calculate_forces with the Marshall set, in its order of operations
+  --------------------------------------------------------------------- */
+
+  template <class Memory, class T = Memory>
+  GC_KERNEL_INLINE void marshall_contact(const Memory *inputs, Memory *out, bool history_update)
+  {
+    namespace MK = MarshallKernels;
+    using N = MK::NumberOps<T>;
+    auto in = [inputs](int q) -> T { return inputs[q]; };
+    const T dx[3] = {in(DX), in(DX + 1), in(DX + 2)};
+    const T vr[3] = {in(VR), in(VR + 1), in(VR + 2)};
+    const T radi = in(RAD_I), radj = in(RAD_J), reff = in(REFF);
+
+    // kinematics
+    const T r = N::sqrt(MK::lensq3(dx));
+    const T rinv = 1.0 / r;
+    const T delta = radi + radj - r;
+    T nx[3], vt[3], wr[3], temp[3], vtr[3];
+    for (int k = 0; k < 3; k++) nx[k] = rinv * dx[k];
+    const T vnnr = MK::dot3(vr, nx);
+    for (int k = 0; k < 3; k++) vt[k] = vr[k] - vnnr * nx[k];
+    for (int k = 0; k < 3; k++) wr[k] = radi * in(OMEGA_I + k) + radj * in(OMEGA_J + k);
+    MK::cross3(wr, nx, temp);
+    for (int k = 0; k < 3; k++) vtr[k] = vt[k] - temp[k];
+
+    // normal: JKR from the root with Marshall damping
+    MK::NormalForceT<T> nf = MK::jkr_normal_force_of_root(in(ASEP), in(FC), in(SQRT_KN_SEP),
+                                                          in(ROOT));
+    if constexpr (std::is_same_v<T, double>) {
+      if (in(HERTZ) != 0.0) nf = MK::hertz_normal_force(in(EMIX), delta, reff);
+    }
+    const T meff = effective_mass(in(MASS_I), in(MASS_J), in(FIXED));
+    const T sqrt_mass = MK::damping_sqrt_mass(in(MASS_FACTOR), meff);
+    const T damp_prefactor = MK::damping_prefactor(in(ALPHA), sqrt_mass, nf);
+    const T fntot = nf.fne + (-damp_prefactor * vnnr);
+    const T fncrit = MK::critical_force(nf);
+
+    // sliding
+    T hist_t[3] = {in(HIST_T), in(HIST_T + 1), in(HIST_T + 2)};
+    T fs[3];
+    MK::tangential_force(hist_t, nx, vtr, in(DT), in(K_T) * nf.a, damp_prefactor,
+                         fncrit * in(MU), history_update, fs);
+
+    T force[3], torque_i[3], torque_j[3];
+    for (int k = 0; k < 3; k++) force[k] = fntot * nx[k] + fs[k];
+    T nxfs[3];
+    MK::cross3(nx, fs, nxfs);
+    const T lever_i = radi - 0.5 * delta, lever_j = radj - 0.5 * delta;
+    for (int k = 0; k < 3; k++) {
+      const T t = nxfs[k] * -1.0;
+      torque_i[k] = t * lever_i;
+      torque_j[k] = t * lever_j;
+    }
+
+    T relrot[3];
+    for (int k = 0; k < 3; k++) relrot[k] = in(OMEGA_I + k) - in(OMEGA_J + k);
+
+    // rolling velocity, eq. 31 of Wang et al, Particuology 23, 49 (2015)
+    T vrl[3], fr[3], torroll[3];
+    vrl[0] = reff * (relrot[1] * nx[2] - relrot[2] * nx[1]);
+    vrl[1] = reff * (relrot[2] * nx[0] - relrot[0] * nx[2]);
+    vrl[2] = reff * (relrot[0] * nx[1] - relrot[1] * nx[0]);
+    T hist_r[3] = {in(HIST_R), in(HIST_R + 1), in(HIST_R + 2)};
+    MK::rolling_force(hist_r, nx, vrl, in(DT), in(XI_CRIT), nf.adhesive / reff, history_update,
+                      fr);
+    MK::cross3(nx, fr, torroll);
+    const auto rolling = in(ROLLING) != 0.0;
+    for (int k = 0; k < 3; k++) {
+      const T tr = torroll[k] * reff;
+      torque_i[k] = N::select(rolling, torque_i[k] + tr, torque_i[k]);
+      torque_j[k] = N::select(rolling, torque_j[k] - tr, torque_j[k]);
+    }
+
+    // twisting: omega_T (eq. 29 of Marshall 2009)
+    const T magtwist = MK::dot3(relrot, nx);
+    T phi = in(HIST_TW);
+    const T moment = MK::twisting_moment(phi, magtwist, in(DT), nf.a, in(K_T), damp_prefactor,
+                                         in(MU) * fncrit, history_update);
+    const auto twisting = in(TWISTING) != 0.0;
+    for (int k = 0; k < 3; k++) {
+      const T tt = moment * nx[k];
+      torque_i[k] = N::select(twisting, torque_i[k] + tt, torque_i[k]);
+      torque_j[k] = N::select(twisting, torque_j[k] - tt, torque_j[k]);
+    }
+
+    for (int k = 0; k < 3; k++) {
+      out[FORCE + k] = force[k];
+      out[TORQUE_I + k] = torque_i[k];
+      out[TORQUE_J + k] = torque_j[k];
+      out[OUT_HIST_T + k] = hist_t[k];
+      out[OUT_HIST_R + k] = N::select(rolling, hist_r[k], in(HIST_R + k));
+    }
+    out[OUT_HIST_TW] = N::select(twisting, phi, in(HIST_TW));
+  }
+
+  // nblocks blocks of WIDTH contacts: block b's input q of lane l at
+  // in[(b * N_INPUT + q) * WIDTH + l], its output q at out[(b * N_OUTPUT + q) * WIDTH + l];
+  // any alignment. Every lane is evaluated (pad a short block with a copy of a valid
+  // contact). HERTZ must be 0: a contact without adhesion takes the scalar instantiation.
+  void contacts_in_lanes(std::size_t nblocks, const double *in, double *out, bool history_update,
+                         gcsimd::SimdPath path);
+  // the same on the default path (gcsimd::default_simd_path(), capped by GCFMM_SIMD)
+  void contacts_in_lanes(std::size_t nblocks, const double *in, double *out, bool history_update);
+
+}    // namespace MarshallLanes
+
+
+}    // namespace LAMMPS_NS
+
+#endif
