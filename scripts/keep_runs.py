@@ -34,7 +34,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "python"))
-from granular_charged import measures  # noqa: E402
+from granular_charged.analysis import measures  # noqa: E402
 from granular_charged.runner import read_result  # noqa: E402
 
 PLAIN = ("result.json", "measures.json")

@@ -436,7 +436,7 @@ def cmd_sweep(a) -> int:
         params = [p for p in params if not is_charged(p.deck_vars())]
     res = Sweep(runner, out, engine=_engine(a)).run(params, a.tracer)
     if figs is not None and params:
-        from .tables import variant
+        from .analysis.tables import variant
         _figures(load_results(out), figs, None, variant(vars(params[0])))
     return 0 if len(res) == len(params) else 1
 
@@ -446,7 +446,8 @@ def cmd_sweep(a) -> int:
 
 
 def _figures(results, out: Path, t2dir: Path | None, variant: str | None = None):
-    from . import figures, tables
+    from . import figures
+    from .analysis import tables
     from .after_formation import load_table2
     results = tables.one_variant(results, variant)
     rows = load_table2(t2dir) if t2dir is not None else []
@@ -486,7 +487,7 @@ def cmd_figures(a) -> int:
 
 
 def cmd_table2(a) -> int:
-    from . import tables
+    from .analysis import tables
     from .after_formation import DECK, OWN, run_table2
     from .deckfile import deck_variables
     from .params import split_deck_vars

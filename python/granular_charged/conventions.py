@@ -32,7 +32,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from . import measures, paper, tables
+from .analysis import measures, tables
+from . import paper
 from .params import DepositionParams
 
 GAMMA = 0.010

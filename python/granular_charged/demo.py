@@ -13,7 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
-from . import claims, paper, tables
+from .analysis import claims, tables
+from . import paper
 from .params import DepositionParams
 from .study import Study
 

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from . import measures, packing, tables
+from .analysis import measures, packing, tables
 from .params import DepositionParams
 
 log = logging.getLogger(__name__)

@@ -25,7 +25,8 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from . import measures, packing, paper, tables
+from .analysis import measures, packing, tables
+from . import paper
 from .params import jkr_scales, pair_modulus
 
 log = logging.getLogger(__name__)
@@ -624,7 +625,7 @@ CONVENTION_BARS = ((("phi", "slab"), ("phi_bed_top", "whole bed, H_p = highest t
 def conventions(results, out: Path):
     """phi and <Z> of every neutral case by the conventions the paper leaves open (mean +- sd
     over the seeds), beside the paper's neutral range of phi_0 and its Table 2 packing."""
-    from . import claims
+    from .analysis import claims
     neutral = [r for r in _ok(results) if r["params"]["q"] == 0]
     if not neutral:
         log.warning("figure conventions: no neutral run")

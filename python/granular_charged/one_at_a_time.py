@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from . import tables
+from .analysis import tables
 from .params import DepositionParams
 
 CHARGES = (260.0, 400.0)

@@ -23,7 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from . import claims, paper, tables
+from .analysis import claims, tables
+from . import paper
 from .demo import STUDY_INJECTION
 from .params import DepositionParams
 from .study import Study

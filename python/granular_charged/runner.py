@@ -26,7 +26,8 @@ import sys
 import time
 from pathlib import Path
 
-from . import packing, population
+from .analysis import packing
+from . import population
 from .deckfile import deck_path, deck_variables
 from .lammps_build import LammpsBuild
 from .logs import read_new_lines

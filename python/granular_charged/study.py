@@ -16,7 +16,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from . import figures, tables
+from . import figures
+from .analysis import tables
 from .after_formation import load_table2
 from .studies.engine import MIN_MINUTES, Engine, deposition_cases, table2_case
 from .params import DepositionParams

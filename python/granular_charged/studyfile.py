@@ -16,7 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import packing, population
+from .analysis import packing
+from . import population
 from .params import DepositionParams, ParamError, param_names
 
 log = logging.getLogger(__name__)

@@ -5,7 +5,8 @@ import json
 import numpy as np
 import pytest
 
-from granular_charged import conventions, measures, paper
+from granular_charged import conventions, paper
+from granular_charged.analysis import measures
 from granular_charged.reproduce import paper_size_params
 
 

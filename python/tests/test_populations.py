@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from granular_charged import packing, population
+from granular_charged.analysis import packing
+from granular_charged import population
 from granular_charged.params import DepositionParams, ParamError
 
 SRC = Path(__file__).resolve().parents[2]

@@ -61,7 +61,7 @@ def test_paper_size_checks_table2_on_every_seeds_packing(tmp_path):
 
 
 def test_table2_frame_names_each_packings_seed():
-    from granular_charged import tables
+    from granular_charged.analysis import tables
     rows = [{"q": q, "phi_before": 0.4, "phi_after": 0.4 + dq, "Z_before": 3.9, "Z_after": 3.9,
              "FC_over_FE": 1e4, "params": {"seed": s}}
             for s in (1, 2) for q, dq in ((0.0, 0.0), (400.0, 1e-5))]

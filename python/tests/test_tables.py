@@ -2,7 +2,7 @@
 import numpy as np
 import pandas as pd
 
-from granular_charged import tables
+from granular_charged.analysis import tables
 
 
 def _runs(rows, estar=None):
@@ -153,7 +153,7 @@ def test_packing_images_of_several_series_get_their_own_names():
 def test_tracer_energy_claim_is_a_mean_over_the_seeds_that_followed_one():
     """The E_k/E_k0 line: mean +- sd and a verdict where several seeds followed a tracer, the
     single value (and no verdict) where one did."""
-    from granular_charged import claims
+    from granular_charged.analysis import claims
     rows = []
     for q, eks in ((0.0, (1.01, 1.00, 1.02)), (260.0, (0.80, np.nan, np.nan)),
                    (400.0, (0.50, 0.55, 0.45))):

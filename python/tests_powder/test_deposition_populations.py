@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from granular_charged import packing, population
+from granular_charged.analysis import packing
+from granular_charged import population
 from granular_charged.params import E0
 
 SRC = Path(__file__).resolve().parents[2]

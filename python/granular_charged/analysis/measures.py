@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from . import packing
-from .params import jkr_scales, pair_modulus
+from ..params import jkr_scales, pair_modulus
 
 log = logging.getLogger(__name__)
 

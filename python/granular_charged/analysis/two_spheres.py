@@ -17,7 +17,7 @@ factor). The force follows from the energy at fixed applied field, U = -1/2 E_0 
 (linear dielectrics in the field of fixed external sources; Landau & Lifshitz, Electrodynamics of
 Continuous Media, section 16), by a central (or, at contact, one-sided) finite difference in d.
 
-`python3 -m granular_charged.two_spheres` prints the table of doc/polarization.md, section 3.1.
+`python3 -m granular_charged.analysis.two_spheres` prints the table of doc/polarization.md, section 3.1.
 """
 from __future__ import annotations
 

@@ -9,7 +9,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from . import measures, packing, paper, tables
+from . import measures, packing, tables
+from .. import paper
 from .tables import CASE, with_uncertainty
 
 SERIES = ["rp_um", "U0", "gamma_mJ"]
