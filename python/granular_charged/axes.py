@@ -9,7 +9,7 @@ log = logging.getLogger("granular_charged")
 def deck_params(pairs, base: dict, popvars: dict, refused: dict, N: int, seed: int):
     """One DepositionParams from --var pairs, the base fields (rp, U0, gamma, q) and population
     variables (which set rp and q when they name them)."""
-    from .deckfile import deck_variables
+    from .run.deckfile import deck_variables
     from .params import DepositionParams, ParamError, param_names, split_deck_vars
     names = {n for n, _ in pairs}
     clash = sorted(names & set(popvars))
@@ -58,8 +58,8 @@ def sweep_params(sets, single, axes, popvars, refused, N, seeds):
 def announce(params, out, inject: str = "auto"):
     """Before a sweep or study: the protocols its runs will use (a warning when they differ, so
     that a charge series does not compare two protocols unknowingly) and the estimated cost."""
-    from . import estimate
-    from .population import protocol
+    from .run import estimate
+    from .run.population import protocol
     by = {}
     for p in params:
         by.setdefault(protocol(p.deck_vars()), []).append(p)

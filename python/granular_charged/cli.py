@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from . import __version__
-from .logs import setup_logging
+from .run.logs import setup_logging
 
 log = logging.getLogger("granular_charged")
 
@@ -308,7 +308,7 @@ _OWN = {"rp": "use --rp", "U0": "use --U0", "gamma": "use --gamma", "q": "use --
 
 
 def _refused(command: str) -> dict:
-    from .runner import RESERVED
+    from .run.runner import RESERVED
     own = dict(_OWN, seed="use --seed" if command == "run" else "use --seeds")
     if command == "reproduce":
         # the study's cases set these; N by its size
@@ -331,7 +331,7 @@ def _refused(command: str) -> dict:
 
 def _population_vars(a) -> dict:
     """Deck variables of --size, --charge, --inject (none when not given)."""
-    from .population import CHARGE_KEYS, SIZE_KEYS, parse_spec, species_vars
+    from .run.population import CHARGE_KEYS, SIZE_KEYS, parse_spec, species_vars
     v = {}
     if getattr(a, "size", None) or getattr(a, "charge", None):
         rp = a.rp[0] if isinstance(a.rp, list) else a.rp
@@ -355,7 +355,7 @@ from .axes import announce, deck_params, sweep_params, var_axes  # noqa: E402
 
 def _vars(a, command: str) -> tuple[dict, dict]:
     """--var pairs checked against the deck that will run: (DepositionParams fields, extra)."""
-    from .deckfile import deck_variables
+    from .run.deckfile import deck_variables
     from .params import split_deck_vars
     return split_deck_vars(a.var, deck_variables("in.deposition"), _refused(command))
 
@@ -373,8 +373,8 @@ def _out_dir(path, option="--out") -> Path:
 
 
 def _runner(a, render=True):
-    from .lammps_build import LammpsBuild
-    from .runner import Runner
+    from .run.lammps_build import LammpsBuild
+    from .run.runner import Runner
     build = LammpsBuild.find(getattr(a, "build_dir", None))
     return Runner(build, np_ranks=getattr(a, "np", 1), render=render,
                   checkpoint=getattr(a, "checkpoint", 0))
@@ -386,14 +386,14 @@ def _engine(a):
 
 
 def cmd_run(a) -> int:
-    from .runner import RunError, Runner
+    from .run.runner import RunError, Runner
     from .sweep import fmt
-    from . import estimate
+    from .run import estimate
     single, _ = var_axes(a.var, "run")
     p = deck_params(single, dict(rp=a.rp, U0=a.U0, gamma=a.gamma, q=a.q), _population_vars(a),
                     _refused("run"), a.N, a.seed)
     Runner.check(p, a.tracer)
-    from .population import protocol
+    from .run.population import protocol
     log.info("injection protocol: %s%s", protocol(p.deck_vars()),
              " (auto: rain when no particle is charged, plane when any is)"
              if a.inject == "auto" else "")
@@ -415,7 +415,7 @@ def cmd_run(a) -> int:
 
 
 def cmd_sweep(a) -> int:
-    from .runner import Runner
+    from .run.runner import Runner
     from .sweep import PAPER_SETS, Sweep, load_results
     single, axes = var_axes(a.var, "sweep")
     sets = PAPER_SETS if a.preset == "paper" else [dict(rp=a.rp, U0=a.U0, gamma=a.gamma, q=a.q)]
@@ -428,7 +428,7 @@ def cmd_sweep(a) -> int:
     figs = _out_dir(a.figures, "--figures") if a.figures else None
     runner = _runner(a, not a.no_render)
     if not runner.build.capabilities["coul/fmm"]:
-        from .population import is_charged
+        from .run.population import is_charged
         skip = [p for p in params if is_charged(p.deck_vars())]
         if skip:
             log.warning("%d charged runs NOT run: fix coul/fmm is absent from %s", len(skip),
@@ -448,7 +448,7 @@ def cmd_sweep(a) -> int:
 def _figures(results, out: Path, t2dir: Path | None, variant: str | None = None):
     from . import figures
     from .analysis import tables
-    from .after_formation import load_table2
+    from .run.after_formation import load_table2
     results = tables.one_variant(results, variant)
     rows = load_table2(t2dir) if t2dir is not None else []
     out.mkdir(parents=True, exist_ok=True)
@@ -488,8 +488,8 @@ def cmd_figures(a) -> int:
 
 def cmd_table2(a) -> int:
     from .analysis import tables
-    from .after_formation import DECK, OWN, run_table2
-    from .deckfile import deck_variables
+    from .run.after_formation import DECK, OWN, run_table2
+    from .run.deckfile import deck_variables
     from .params import split_deck_vars
     _, extra = split_deck_vars(a.var, deck_variables(DECK), OWN, DECK)
     out = _out_dir(a.out)
@@ -500,7 +500,7 @@ def cmd_table2(a) -> int:
 
 def cmd_reproduce(a) -> int:
     from .reproduce import Reproduction, report
-    from .runner import Runner
+    from .run.runner import Runner
     fields, extra = _vars(a, "reproduce")
     study = Reproduction(out=_out_dir(a.out), size_name=a.size, seeds=tuple(a.seeds),
                          extra=extra, fields=fields, jobs=a.jobs, progress=a.progress,
@@ -516,7 +516,7 @@ def cmd_reproduce(a) -> int:
 
 def cmd_demo(a) -> int:
     from .demo import DEMO_VARS, Demo, claims_report, report
-    from .runner import Runner
+    from .run.runner import Runner
     fields, extra = _vars(a, "demo")
     study = Demo(out=_out_dir(a.out), N=a.N, qs=tuple(a.q), seeds=tuple(a.seeds),
                  table2_qs=tuple(a.table2_q), extra={**DEMO_VARS, **extra}, fields=fields,
@@ -548,7 +548,7 @@ def _study_runs(a, params) -> tuple[Path, list[dict]]:
 
 def cmd_epd(a) -> int:
     from . import epd
-    from .runner import Runner
+    from .run.runner import Runner
     _, extra = _vars(a, "epd")
     params = epd.study_params(tuple(a.seeds))
     for p in params:
@@ -569,7 +569,7 @@ def _checked_study(a, command: str, study_params):
     """The runs of a study of fixed runs: its parameters (study_params(seeds, extra=, fields=)
     with the --var pairs checked for the command), each checked, then _study_runs; returns
     (out, params, results)."""
-    from .runner import Runner
+    from .run.runner import Runner
     fields, extra = _vars(a, command)
     params = study_params(tuple(a.seeds), extra=extra, fields=fields)
     for p in params:
@@ -628,9 +628,9 @@ def main(argv=None) -> int:
     setup_logging(verbose, quiet)
     a.progress = quiet == 0 and sys.stderr.isatty()
     from .studies.engine import DryRunDone, EngineError
-    from .lammps_build import BuildError
+    from .run.lammps_build import BuildError
     from .params import ParamError
-    from .runner import RunError
+    from .run.runner import RunError
     try:
         return COMMANDS[a.command](a)
     except DryRunDone:

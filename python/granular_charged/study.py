@@ -18,10 +18,10 @@ from pathlib import Path
 
 from . import figures
 from .analysis import tables
-from .after_formation import load_table2
+from .run.after_formation import load_table2
 from .studies.engine import MIN_MINUTES, Engine, deposition_cases, table2_case
 from .params import DepositionParams
-from .runner import Runner
+from .run.runner import Runner
 from .sweep import describe_result, finished_results
 
 log = logging.getLogger(__name__)

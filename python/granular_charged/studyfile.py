@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from .analysis import packing
-from . import population
+from .run import population
 from .params import DepositionParams, ParamError, param_names
 
 log = logging.getLogger(__name__)
@@ -54,7 +54,7 @@ def load(path) -> dict:
 def params(d: dict) -> list[DepositionParams]:
     """Every run of the study (grid x seeds)."""
     from .axes import deck_params
-    from .runner import RESERVED
+    from .run.runner import RESERVED
     species = d.get("species")
     if species is None:
         pop = dict(d.get("population", {}))

@@ -15,7 +15,7 @@ from types import MappingProxyType
 
 from .studies.engine import Engine, deposition_cases
 from .params import DepositionParams
-from .runner import Runner, load_result_files, read_result
+from .run.runner import Runner, load_result_files, read_result
 
 log = logging.getLogger(__name__)
 

@@ -18,7 +18,8 @@ import numpy as np
 import pytest
 
 from conftest import SRC
-from granular_charged import deckfile, params, runner, sweep
+from granular_charged.run import deckfile, runner
+from granular_charged import params, sweep
 from granular_charged.analysis import tables
 from granular_charged.params import DepositionParams, ParamError
 
@@ -200,7 +201,7 @@ def test_figures_of_broken_results_is_an_error_not_a_traceback(tmp_path):
 
 
 def test_table2_rows_with_missing_keys_are_left_out(tmp_path, caplog):
-    from granular_charged.after_formation import load_table2
+    from granular_charged.run.after_formation import load_table2
     (tmp_path / "q0").mkdir()
     (tmp_path / "q0" / "result.json").write_text(json.dumps({"q": 0.0}))
     assert load_table2(tmp_path) == [] and "keys missing: phi_before" in caplog.text

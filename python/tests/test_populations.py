@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from granular_charged.analysis import packing
-from granular_charged import population
+from granular_charged.run import population
 from granular_charged.params import DepositionParams, ParamError
 
 SRC = Path(__file__).resolve().parents[2]
@@ -159,7 +159,7 @@ def test_figures_carry_the_users_material_not_the_paper(monkeypatch, tmp_path):
     theirs (all_figures decides; rdf and fZ are drawn here from two kept paper-size runs)."""
     import copy
     from granular_charged import figures
-    from granular_charged.runner import load_result_files
+    from granular_charged.run.runner import load_result_files
     kept = SRC / "doc" / "data" / "paper-size" / "runs"
     res = load_result_files([kept / "rp2um_U1_g10mJ_q0_N2000_s1" / "result.json",
                              kept / "rp2um_U1_g10mJ_q400_N2000_s1_exact" / "result.json"])
@@ -182,7 +182,7 @@ def test_figures_carry_the_users_material_not_the_paper(monkeypatch, tmp_path):
 def test_progress_bar_follows_the_log(tmp_path):
     """The run's bar reads the deck's GC PROGRESS lines as log.lammps grows (a partial last line
     is left for the next read)."""
-    from granular_charged.runner import Runner
+    from granular_charged.run.runner import Runner
 
     class Bar:
         total = n = None

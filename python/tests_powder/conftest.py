@@ -12,7 +12,7 @@ sys.path.insert(0, str(SRC / "python"))
 
 @pytest.fixture(scope="session")
 def build_dir():
-    from granular_charged.lammps_build import BuildError, locate_build
+    from granular_charged.run.lammps_build import BuildError, locate_build
     try:
         return locate_build(os.environ.get("GC_BUILD_DIR"))
     except BuildError as e:

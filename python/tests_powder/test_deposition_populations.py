@@ -15,7 +15,7 @@ import pytest
 from scipy import stats
 
 from granular_charged.analysis import packing
-from granular_charged import population
+from granular_charged.run import population
 from granular_charged.params import E0
 
 SRC = Path(__file__).resolve().parents[2]
@@ -79,7 +79,7 @@ def test_deck_draws_follow_the_requested_distributions(lognormal_gauss_run):
     assert text.count("Loop time") <= 4, "log.lammps holds the one-by-one loop's runs"
     prog = [ln for ln in text.splitlines() if ln.startswith("GC PROGRESS")]
     assert len(prog) >= 10 and prog[-1].startswith("GC PROGRESS 120 / 120")
-    from granular_charged.runner import parse_progress
+    from granular_charged.run.runner import parse_progress
     assert parse_progress(prog[-1])["k"] == 120
 
 

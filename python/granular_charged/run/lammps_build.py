@@ -29,7 +29,7 @@ def _is_build(p: Path) -> bool:
 
 def _package_parent() -> Path:
     """The folder that holds the granular_charged package (a checkout's python/, or site-packages)."""
-    return Path(__file__).resolve().parent.parent
+    return Path(__file__).resolve().parents[2]
 
 
 def locate_build(build_dir: str | os.PathLike | None = None) -> Path:

@@ -15,13 +15,13 @@ import math
 from pathlib import Path
 
 from . import population
-from .params import DepositionParams, time_step
+from ..params import DepositionParams, time_step
 
 # when no finished run is found: c of the kept runs of this package (neutral, charged) and a
 # factor 3 either way
 DEFAULT_C = {False: 2.0e-7, True: 1.5e-6}
 DEFAULT_FACTOR = 3.0
-KEPT = Path(__file__).resolve().parents[2] / "doc" / "data"
+KEPT = Path(__file__).resolve().parents[3] / "doc" / "data"
 
 
 def _x(p: DepositionParams, key: str, default: float) -> float:

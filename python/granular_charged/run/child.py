@@ -1,8 +1,8 @@
 """The child side of a run: drive LAMMPS through its Python module in this process, then read the
 results from the LAMMPS instance and write them as JSON (rank 0), and render the packing.
 
-Started by :class:`granular_charged.runner.Runner` as
-``python -m granular_charged.child DECK WORKDIR --kind deposition --var NAME VALUE ...``,
+Started by :class:`granular_charged.run.runner.Runner` as
+``python -m granular_charged.run.child DECK WORKDIR --kind deposition --var NAME VALUE ...``,
 optionally under ``mpirun -np K``; not meant to be called by hand.
 """
 from __future__ import annotations
@@ -14,7 +14,7 @@ import os
 import sys
 import threading
 
-from .paper import Z_COLORS
+from ..paper import Z_COLORS
 
 IMAGE = "packing.png"   # rendered final packing, coloured by Z
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 
-from .params import E0, ParamError, population_charged
+from ..params import E0, ParamError, population_charged
 
 SIZE_KEYS = {"one": ("r",), "uniform": ("lo", "hi"), "lognormal": ("median", "gsd", "lo", "hi"),
              "discrete": ("radii", "fractions")}
@@ -189,7 +189,7 @@ def _get(vars_: dict, name: str, s: int, default):
 def describe(vars_: dict) -> dict:
     """The population of a run from its deck variables (DepositionParams.deck_vars()):
     {'species': [{'fraction', 'size', 'charge', 'material'}...]}; the record of result.json."""
-    from .params import DepositionParams as D
+    from ..params import DepositionParams as D
     n = int(float(vars_.get("species", 1)))
     fr = [float(vars_.get("frac" if s == 1 else f"frac_{s}", 1.0)) for s in range(1, n + 1)]
     out = []

@@ -10,9 +10,9 @@ import json
 import logging
 from pathlib import Path
 
-from .analysis import tables
+from ..analysis import tables
 from .deckfile import deck_variables
-from .params import ParamError, coulomb_to_adhesion
+from ..params import ParamError, coulomb_to_adhesion
 from .runner import RunError, Runner, load_result_files, read_result, write_json
 
 DECK = "in.charged-after-formation"
