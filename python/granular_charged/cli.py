@@ -350,7 +350,7 @@ def _population_vars(a) -> dict:
 
 
 
-from .axes import announce, deck_params, sweep_params, var_axes  # noqa: E402
+from .studies.axes import announce, deck_params, sweep_params, var_axes  # noqa: E402
 
 
 def _vars(a, command: str) -> tuple[dict, dict]:
@@ -387,7 +387,7 @@ def _engine(a):
 
 def cmd_run(a) -> int:
     from .run.runner import RunError, Runner
-    from .sweep import fmt
+    from .studies.sweep import fmt
     from .run import estimate
     single, _ = var_axes(a.var, "run")
     p = deck_params(single, dict(rp=a.rp, U0=a.U0, gamma=a.gamma, q=a.q), _population_vars(a),
@@ -416,7 +416,7 @@ def cmd_run(a) -> int:
 
 def cmd_sweep(a) -> int:
     from .run.runner import Runner
-    from .sweep import PAPER_SETS, Sweep, load_results
+    from .studies.sweep import PAPER_SETS, Sweep, load_results
     single, axes = var_axes(a.var, "sweep")
     sets = PAPER_SETS if a.preset == "paper" else [dict(rp=a.rp, U0=a.U0, gamma=a.gamma, q=a.q)]
     popvars = _population_vars(a)
@@ -463,7 +463,7 @@ def _figures(results, out: Path, t2dir: Path | None, variant: str | None = None)
 
 
 def cmd_study(a) -> int:
-    from . import studyfile
+    from .studies import studyfile
     if a.estimate_only:
         d = studyfile.load(a.file)
         announce(studyfile.params(d), Path(d["out"]) / "runs", d["protocol"])
@@ -476,7 +476,7 @@ def cmd_study(a) -> int:
 
 
 def cmd_figures(a) -> int:
-    from .sweep import load_results
+    from .studies.sweep import load_results
     out = _out_dir(a.out)
     results = load_results(Path(a.results))
     if not results:
@@ -499,7 +499,7 @@ def cmd_table2(a) -> int:
 
 
 def cmd_reproduce(a) -> int:
-    from .reproduce import Reproduction, report
+    from .studies.reproduce import Reproduction, report
     from .run.runner import Runner
     fields, extra = _vars(a, "reproduce")
     study = Reproduction(out=_out_dir(a.out), size_name=a.size, seeds=tuple(a.seeds),
@@ -515,7 +515,7 @@ def cmd_reproduce(a) -> int:
 
 
 def cmd_demo(a) -> int:
-    from .demo import DEMO_VARS, Demo, claims_report, report
+    from .studies.demo import DEMO_VARS, Demo, claims_report, report
     from .run.runner import Runner
     fields, extra = _vars(a, "demo")
     study = Demo(out=_out_dir(a.out), N=a.N, qs=tuple(a.q), seeds=tuple(a.seeds),
@@ -534,7 +534,7 @@ def cmd_demo(a) -> int:
 def _study_runs(a, params) -> tuple[Path, list[dict]]:
     """A study of fixed runs (epd, conventions): run what is not finished in OUT/runs (nothing
     with --finished-only), then the finished runs of the study there (logged when none)."""
-    from .sweep import Sweep, load_results
+    from .studies.sweep import Sweep, load_results
     out = _out_dir(a.out)
     runs = out / "runs"
     if not a.finished_only:
@@ -547,7 +547,7 @@ def _study_runs(a, params) -> tuple[Path, list[dict]]:
 
 
 def cmd_epd(a) -> int:
-    from . import epd
+    from .studies import epd
     from .run.runner import Runner
     _, extra = _vars(a, "epd")
     params = epd.study_params(tuple(a.seeds))
@@ -588,7 +588,7 @@ def _study_report(a, out: Path, name: str, params, results, *parts: str) -> int:
 
 
 def cmd_conventions(a) -> int:
-    from . import conventions
+    from .studies import conventions
     out, params, results = _checked_study(a, "conventions", conventions.study_params)
     if not results:
         return 1
@@ -605,7 +605,7 @@ def cmd_conventions(a) -> int:
 
 
 def cmd_one_at_a_time(a) -> int:
-    from . import one_at_a_time as study
+    from .studies import one_at_a_time as study
     out, params, results = _checked_study(a, "one-at-a-time", study.study_params)
     if not results:
         return 1

@@ -19,7 +19,8 @@ import pytest
 
 from conftest import SRC
 from granular_charged.run import deckfile, runner
-from granular_charged import params, sweep
+from granular_charged import params
+from granular_charged.studies import sweep
 from granular_charged.analysis import tables
 from granular_charged.params import DepositionParams, ParamError
 

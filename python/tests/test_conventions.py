@@ -1,13 +1,14 @@
-"""The phi_0 question's study (granular_charged.conventions): its runs, its per-case means and
+"""The phi_0 question's study (granular_charged.studies.conventions): its runs, its per-case means and
 its three checks against the paper's printed numbers, on runs with known measures."""
 import json
 
 import numpy as np
 import pytest
 
-from granular_charged import conventions, paper
+from granular_charged.studies import conventions
+from granular_charged import paper
 from granular_charged.analysis import measures
-from granular_charged.reproduce import paper_size_params
+from granular_charged.studies.reproduce import paper_size_params
 
 
 def _result(tmp_path, theta, rp, u0, q, seed, phi, Z, surface=None, top=None, Z_all=None):

@@ -1,10 +1,10 @@
-"""The EPD study's table (granular_charged.epd) on runs with known contacts, and its run list."""
+"""The EPD study's table (granular_charged.studies.epd) on runs with known contacts, and its run list."""
 import json
 
 import numpy as np
 import pytest
 
-from granular_charged import epd
+from granular_charged.studies import epd
 
 
 def _layers(path, nlayers):

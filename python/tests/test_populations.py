@@ -81,8 +81,8 @@ def test_var_axes_are_a_product_with_the_other_axes():
 
 
 def test_study_file_grid_seeds_and_protocol_warning(tmp_path, caplog):
-    from granular_charged import studyfile
-    from granular_charged.axes import announce
+    from granular_charged.studies import studyfile
+    from granular_charged.studies.axes import announce
     f = tmp_path / "s.toml"
     f.write_text('name = "my dust"\nseeds = [1, 2, 3]\n[deck]\nU0 = 0.5\nN = 40\n'
                  '[material]\nrho = 3000\nE = 1e8\ngamma = 0.02\n'

@@ -32,9 +32,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .analysis import measures, tables
-from . import paper
-from .params import DepositionParams
+from ..analysis import measures, tables
+from .. import paper
+from ..params import DepositionParams
 
 GAMMA = 0.010
 # (r_p [m], U_0 [m/s], q [e_0]): the three neutral series of the paper's Fig. 3, then the
@@ -231,7 +231,7 @@ def figure(t: pd.DataFrame, out) -> Path | None:
     the rolling limit (mean +- sd over the seeds) with the paper's range as a band and its Table
     2 phi_0 as a star at every theta_crit; beside it <Z>_0 of the Table 2 case (slab and all
     particles) with the paper's 3.2056. The plotted means beside it as CSV."""
-    from . import figures as fg
+    from .. import figures as fg
     neutral = t[t["q"] == 0]
     if neutral.empty:
         return None

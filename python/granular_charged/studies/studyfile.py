@@ -15,10 +15,14 @@ import tomllib
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
-from .analysis import packing
-from .run import population
-from .params import DepositionParams, ParamError, param_names
+from ..analysis import packing
+from ..params import DepositionParams, ParamError, param_names
+from ..run import population
+from ..run.runner import RESERVED
+from .axes import announce, deck_params
+from .sweep import Sweep
 
 log = logging.getLogger(__name__)
 
@@ -53,8 +57,6 @@ def load(path) -> dict:
 
 def params(d: dict) -> list[DepositionParams]:
     """Every run of the study (grid x seeds)."""
-    from .axes import deck_params
-    from .run.runner import RESERVED
     species = d.get("species")
     if species is None:
         pop = dict(d.get("population", {}))
@@ -103,7 +105,6 @@ def grid_value(r: dict, name: str):
 
 def tables(d: dict, results: list[dict], out: Path):
     """runs.csv, summary.csv (mean +- sd over the seeds per grid point) and classes.csv."""
-    import pandas as pd
     names = list(d.get("grid", {}))
     rows, cls = [], []
     for r in results:
@@ -144,7 +145,7 @@ def study_label(d: dict, results: list[dict]) -> str:
     population's rules, gamma, U0), the protocols and N."""
     if not results:
         return d["name"]
-    from .figures import material_label
+    from ..figures import material_label
     p0 = results[0]["params"]
     protos = sorted({str(r.get("protocol")) for r in results})
     mat = ", ".join(x for x in (material_label(results), f"gamma {p0['gamma']:g}",
@@ -212,8 +213,6 @@ def figures(d: dict, results: list[dict], out: Path) -> list[Path]:
 
 def run(path, runner, jobs: int = 1, progress: bool = True, engine=None) -> dict:
     """Run a study file: the runs (resumable), then tables and figures under its out folder."""
-    from .axes import announce
-    from .sweep import Sweep
     d = load(path)
     ps = params(d)
     for p in ps:

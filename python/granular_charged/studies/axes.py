@@ -2,15 +2,20 @@
 DepositionParams, and what a sweep or a study says before it starts (protocols, cost)."""
 from __future__ import annotations
 
+import itertools
 import logging
 
+from ..params import DepositionParams, ParamError, param_names, split_deck_vars
+from ..run import estimate
+from ..run.deckfile import deck_variables
+from ..run.population import protocol
+
 log = logging.getLogger("granular_charged")
+
 
 def deck_params(pairs, base: dict, popvars: dict, refused: dict, N: int, seed: int):
     """One DepositionParams from --var pairs, the base fields (rp, U0, gamma, q) and population
     variables (which set rp and q when they name them)."""
-    from .run.deckfile import deck_variables
-    from .params import DepositionParams, ParamError, param_names, split_deck_vars
     names = {n for n, _ in pairs}
     clash = sorted(names & set(popvars))
     if clash:
@@ -24,10 +29,10 @@ def deck_params(pairs, base: dict, popvars: dict, refused: dict, N: int, seed: i
             extra[k] = v
     return DepositionParams(N=N, seed=seed, extra=extra, **fields)
 
+
 def var_axes(items, command: str):
     """--var NAME V1 [V2 ...] items as (single pairs, axes [(name, values)]); several values only
     where the command sweeps."""
-    from .params import ParamError
     single, axes = [], []
     for item in items:
         if len(item) < 2:
@@ -40,10 +45,10 @@ def var_axes(items, command: str):
             axes.append((item[0], item[1:]))
     return single, axes
 
+
 def sweep_params(sets, single, axes, popvars, refused, N, seeds):
     """Every combination of the sets' values (rp, U0, gamma, q), the --var axes and the seeds,
     each run once."""
-    import itertools
     out = []
     names = [n for n, _ in axes]
     for s in sets:
@@ -55,11 +60,10 @@ def sweep_params(sets, single, axes, popvars, refused, N, seeds):
                                        refused, N, seed))
     return list({p.key(): p for p in out}.values())
 
+
 def announce(params, out, inject: str = "auto"):
     """Before a sweep or study: the protocols its runs will use (a warning when they differ, so
     that a charge series does not compare two protocols unknowingly) and the estimated cost."""
-    from .run import estimate
-    from .run.population import protocol
     by = {}
     for p in params:
         by.setdefault(protocol(p.deck_vars()), []).append(p)

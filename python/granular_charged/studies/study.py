@@ -16,12 +16,12 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from . import figures
-from .analysis import tables
-from .run.after_formation import load_table2
-from .studies.engine import MIN_MINUTES, Engine, deposition_cases, table2_case
-from .params import DepositionParams
-from .run.runner import Runner
+from .. import figures
+from ..analysis import tables
+from ..run.after_formation import load_table2
+from .engine import MIN_MINUTES, Engine, deposition_cases, table2_case
+from ..params import DepositionParams
+from ..run.runner import Runner
 from .sweep import describe_result, finished_results
 
 log = logging.getLogger(__name__)

@@ -13,9 +13,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
-from .analysis import claims, tables
-from . import paper
-from .params import DepositionParams
+from ..analysis import claims, tables
+from .. import paper
+from ..params import DepositionParams
 from .study import Study
 
 # demo and reproduce: the rain from H at one particle per r_p for every charge: quick, and its

@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .analysis import measures, packing, tables
-from .params import DepositionParams
+from ..analysis import measures, packing, tables
+from ..params import DepositionParams
 
 log = logging.getLogger(__name__)
 
@@ -87,7 +87,7 @@ def figures(results: list[dict], out: Path) -> list[Path]:
     side coloured by Z (figures.packing_panel: LAMMPS's render, or the side view from the dump),
     and orientation.png, the distribution of |cos theta| of the contacts against the field per
     case (mean over the seeds; isotropic contacts: uniform, density 1). Data beside as CSV."""
-    from . import figures as fg
+    from .. import figures as fg
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     ok = [r for r in results if r.get("phi") is not None]

@@ -19,8 +19,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .analysis import tables
-from .params import DepositionParams
+from ..analysis import tables
+from ..params import DepositionParams
 
 CHARGES = (260.0, 400.0)
 CASE = {"rp": 2e-6, "U0": 1.0, "gamma": 0.010}
