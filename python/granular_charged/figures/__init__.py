@@ -25,9 +25,9 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from .analysis import measures, packing, tables
-from . import paper
-from .params import jkr_scales, pair_modulus
+from ..analysis import measures, packing, tables
+from .. import paper
+from ..params import jkr_scales, pair_modulus
 
 log = logging.getLogger(__name__)
 
@@ -82,7 +82,7 @@ def _paper() -> bool:
 def material_label(results) -> str:
     """The material of the runs as a label ('' for the paper's): the values that differ from
     the paper's Table 1 and the population (its rules), e.g. 'rho 3000, E 1e+08, uniform radii'."""
-    from .params import DepositionParams as D
+    from ..params import DepositionParams as D
     parts = {}
     for r in results:
         p = r["params"]
@@ -136,7 +136,7 @@ def packing_image_names(results: list[dict]) -> list[str]:
     one series (r_p, U_0, gamma), else with the series in front, packing_rp<r_p>um_U<U_0>_g
     <gamma>mJ_q<q>_s<seed>.png (with the short names, the nine neutral cases of the paper-size
     study wrote one file, packing_q0_s1.png, in turn)."""
-    from .params import series_name
+    from ..params import series_name
 
     def series(p):
         return series_name(p["rp"], p["U0"], p["gamma"]) + "_"
@@ -625,7 +625,7 @@ CONVENTION_BARS = ((("phi", "slab"), ("phi_bed_top", "whole bed, H_p = highest t
 def conventions(results, out: Path):
     """phi and <Z> of every neutral case by the conventions the paper leaves open (mean +- sd
     over the seeds), beside the paper's neutral range of phi_0 and its Table 2 packing."""
-    from .analysis import claims
+    from ..analysis import claims
     neutral = [r for r in _ok(results) if r["params"]["q"] == 0]
     if not neutral:
         log.warning("figure conventions: no neutral run")
