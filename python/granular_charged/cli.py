@@ -446,7 +446,7 @@ def cmd_sweep(a) -> int:
 
 
 def _figures(results, out: Path, t2dir: Path | None, variant: str | None = None):
-    from . import figures
+    from .figures.plan import all_figures
     from .analysis import tables
     from .run.after_formation import load_table2
     results = tables.one_variant(results, variant)
@@ -457,7 +457,7 @@ def _figures(results, out: Path, t2dir: Path | None, variant: str | None = None)
         s.to_csv(out / "summary.csv", index=False)
         print(tables.format_table(s[["rp_um", "U0", "gamma_mJ", "q", "runs", "phi", "phi_sd", "Z",
                                      "Z_sd", "Adstar", "expansion"]]))
-    paths = figures.all_figures(results, out, rows)
+    paths = all_figures(results, out, rows)
     log.info("%d figures in %s", len(paths), out.resolve())
     return paths
 
@@ -560,7 +560,8 @@ def cmd_epd(a) -> int:
     t = epd.table(results)
     t.to_csv(out / "epd.csv", index=False)
     print(epd.format_table(t))
-    for path in epd.figures(results, out / "figures"):
+    from .figures.epd import epd_figures
+    for path in epd_figures(results, out / "figures"):
         print(f"figure: {path}")
     return 0 if a.finished_only or len(results) == len(params) else 1
 
@@ -598,7 +599,8 @@ def cmd_conventions(a) -> int:
     c.to_csv(out / "conventions_checks.csv", index=False)
     status = _study_report(a, out, "conventions", params, results, conventions.format_cases(t),
                            conventions.format_checks(c), conventions.verdict(c))
-    path = conventions.figure(t, out / "figures")
+    from .figures.conventions import phi0_question
+    path = phi0_question(t, out / "figures")
     if path:
         print(f"figure: {path}")
     return status

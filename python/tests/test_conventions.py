@@ -5,9 +5,10 @@ import json
 import numpy as np
 import pytest
 
-from granular_charged.studies import conventions
 from granular_charged import paper
 from granular_charged.analysis import measures
+from granular_charged.figures.conventions import phi0_question
+from granular_charged.studies import conventions
 from granular_charged.studies.reproduce import paper_size_params
 
 
@@ -78,7 +79,7 @@ def test_case_means_and_the_three_checks(tmp_path):
     text = conventions.format_checks(c.reset_index())
     assert "0.3249 +- 0.0020" in text and "0.300-0.340" in text
     # the figure: the paper's numbers beside ours, the plotted means as CSV
-    path = conventions.figure(t, tmp_path / "fig")
+    path = phi0_question(t, tmp_path / "fig")
     assert path.stat().st_size > 10000
     import pandas as pd
     assert len(pd.read_csv(path.with_suffix(".csv"))) == len(t)

@@ -4,6 +4,7 @@ import json
 import numpy as np
 import pytest
 
+from granular_charged.figures.epd import epd_figures
 from granular_charged.studies import epd
 
 
@@ -69,7 +70,7 @@ def test_figures_draw_every_case_and_the_orientation(tmp_path):
     for r in rs:
         r["params"]["q"] = 400.0
         r["natoms"] = 16
-    paths = epd.figures(rs, tmp_path / "figures")
+    paths = epd_figures(rs, tmp_path / "figures")
     assert [p.name for p in paths] == ["packings.png", "orientation.png"]
     assert all(p.stat().st_size > 10000 for p in paths)
     import pandas as pd

@@ -6,14 +6,16 @@ draws and the bookkeeping, not the packing's statistics."""
 import os
 import re
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from granular_charged.analysis import packing
-from granular_charged.run import population
+from granular_charged.figures.studyfile import study_label
 from granular_charged.params import DepositionParams, ParamError
+from granular_charged.run import population
 
 SRC = Path(__file__).resolve().parents[2]
 DECK = SRC / "python" / "granular_charged" / "decks" / "in.deposition"
@@ -104,7 +106,7 @@ def test_study_file_grid_seeds_and_protocol_warning(tmp_path, caplog):
     assert "estimated cost" in caplog.text
     # the figures' title names the study and its material
     fake = [{"params": dict(vars(p), extra=dict(p.extra)), "protocol": "plane"} for p in ps]
-    label = studyfile.study_label(d, fake)
+    label = study_label(d, fake)
     assert label.startswith("my dust (rho 3000, E 1e+08, uniform radii, area charges, gamma 0.02")
     assert "paper" not in label
 
@@ -139,7 +141,6 @@ def test_powder_example_short_version(build_dir, tmp_path):
 
 def _figure_texts(monkeypatch, fn, results, out):
     """Every text (titles, labels, legend entries) of the figures fn draws from results."""
-    from granular_charged import figures
     texts = []
 
     def capture(fig, path, data=None, tight=True):
@@ -149,7 +150,7 @@ def _figure_texts(monkeypatch, fn, results, out):
         plt.close(fig)
         return path
 
-    monkeypatch.setattr(figures, "save", capture)
+    monkeypatch.setattr(sys.modules[fn.__module__], "save", capture)
     fn(results, out)
     return " ".join(texts)
 
@@ -158,25 +159,25 @@ def test_figures_carry_the_users_material_not_the_paper(monkeypatch, tmp_path):
     """The paper's annotations only on the paper's material; a user's runs are labelled with
     theirs (all_figures decides; rdf and fZ are drawn here from two kept paper-size runs)."""
     import copy
-    from granular_charged import figures
+    from granular_charged.figures import base, expansion, structure
     from granular_charged.run.runner import load_result_files
     kept = SRC / "doc" / "data" / "paper-size" / "runs"
     res = load_result_files([kept / "rp2um_U1_g10mJ_q0_N2000_s1" / "result.json",
                              kept / "rp2um_U1_g10mJ_q400_N2000_s1_exact" / "result.json"])
     assert len(res) == 2
-    figures.PAPER.update(on=not figures.material_label(res), material=figures.material_label(res))
-    assert "paper" in _figure_texts(monkeypatch, figures.rdf, res, tmp_path)
+    base.PAPER.update(on=not base.material_label(res), material=base.material_label(res))
+    assert "paper" in _figure_texts(monkeypatch, structure.rdf, res, tmp_path)
     mine = copy.deepcopy(res)
     for r in mine:
         r["params"]["rho"] = 3000.0
         r["params"]["extra"] = dict(r["params"].get("extra") or {}, r_dist="uniform")
-    lab = figures.material_label(mine)
+    lab = base.material_label(mine)
     assert lab == "rho 3000, uniform radii"
-    figures.PAPER.update(on=False, material=lab)
-    for fn in (figures.rdf, figures.fZ, figures.phi_vs_q):
+    base.PAPER.update(on=False, material=lab)
+    for fn in (structure.rdf, structure.fZ, expansion.phi_vs_q):
         t = _figure_texts(monkeypatch, fn, mine, tmp_path)
         assert "paper" not in t.lower() and "rho 3000" in t, fn.__name__
-    figures.PAPER.update(on=True, material="")
+    base.PAPER.update(on=True, material="")
 
 
 def test_progress_bar_follows_the_log(tmp_path):

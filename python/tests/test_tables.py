@@ -141,7 +141,7 @@ def test_one_variant_refuses_to_average_several():
 def test_packing_images_of_several_series_get_their_own_names():
     """The nine neutral cases of the paper-size study are all q = 0, seed 1: with names by q and
     seed only they wrote one file in turn; one series keeps the short names (the demo's)."""
-    from granular_charged.figures import packing_image_names
+    from granular_charged.figures.packings import packing_image_names
     one = [_params(q=q, seed=s) for q in (0.0, 400.0) for s in (1, 2)]
     assert packing_image_names(one) == ["packing_q0_s1.png", "packing_q0_s2.png",
                                         "packing_q400_s1.png", "packing_q400_s2.png"]

@@ -256,3 +256,9 @@ def table2_frame(rows: list[dict]) -> pd.DataFrame:
 
 def format_table(df: pd.DataFrame, floatfmt: str = "{:.4g}") -> str:
     return df.to_string(index=False, float_format=lambda v: floatfmt.format(v))
+
+
+def grid_value(r: dict, name: str):
+    """The value of a grid axis in a result (a field, or a deck variable of params.extra)."""
+    p = r["params"]
+    return p[name] if name in p else (p.get("extra") or {}).get(name)

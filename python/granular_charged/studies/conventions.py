@@ -27,7 +27,6 @@ The checks, each against numbers printed in the paper's text (module ``paper``),
 from __future__ import annotations
 
 import itertools
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -216,53 +215,3 @@ def verdict(c: pd.DataFrame) -> str:
     names = "; ".join(f"theta_crit {r.theta_crit:g}, phi {r.phi_definition}, <Z> {r.Z_definition}"
                       for r in ok.itertuples())
     return head + f"\npasses all three checks: {names}" + rest
-
-
-def _rolling_axis(ax, thetas):
-    ax.set_xscale("log")
-    ax.set_xticks(thetas, [f"{v:g}" for v in thetas])
-    ax.minorticks_off()
-    ax.set_xlabel("theta_crit (rolling limit)")
-
-
-def figure(t: pd.DataFrame, out) -> Path | None:
-    """phi0_question.png in OUT (beside reproduce's conventions.png, which compares the cases at the
-    deck's rolling limit): per phi definition, the neutral phi_0 of the three series against
-    the rolling limit (mean +- sd over the seeds) with the paper's range as a band and its Table
-    2 phi_0 as a star at every theta_crit; beside it <Z>_0 of the Table 2 case (slab and all
-    particles) with the paper's 3.2056. The plotted means beside it as CSV."""
-    from .. import figures as fg
-    neutral = t[t["q"] == 0]
-    if neutral.empty:
-        return None
-    fig = fg.new_figure(3.0 * (len(PHI_DEFINITIONS) + 1), 3.3)
-    lo, hi = paper.PHI0_RANGE
-    thetas = sorted(neutral["theta_crit"].unique())
-    for k, (name, col) in enumerate(PHI_DEFINITIONS.items()):
-        ax = fig.add_subplot(1, len(PHI_DEFINITIONS) + 1, k + 1)
-        ax.axhspan(lo, hi, color="0.85", label=f"paper: phi_0 {lo}-{hi}")
-        ax.plot(thetas, [paper.TABLE2[0][1]] * len(thetas), "k*", ms=8,
-                label=f"paper Table 2: {paper.TABLE2[0][1]}")
-        for (rp, u0), d in neutral.groupby(["rp_um", "U0"]):
-            d = d.sort_values("theta_crit")
-            ax.errorbar(d["theta_crit"], d[col], yerr=d[f"{col}_sd"].fillna(0.0), marker="o",
-                        ms=3, capsize=2, label=f"{rp:g} um, {u0:g} m/s")
-        _rolling_axis(ax, thetas)
-        ax.set_ylabel("phi_0")
-        ax.set_title(f"phi: {name}", fontsize=8)
-        if k == 0:
-            ax.legend(fontsize=6)
-    ax = fig.add_subplot(1, len(PHI_DEFINITIONS) + 1, len(PHI_DEFINITIONS) + 1)
-    fig2 = neutral[np.isclose(neutral["rp_um"], TABLE2_CASE[0]) & np.isclose(neutral["U0"], TABLE2_CASE[1])]
-    fig2 = fig2.sort_values("theta_crit")
-    ax.axhline(paper.TABLE2[0][2], color="k", ls="--", label=f"paper Table 2: {paper.TABLE2[0][2]}")
-    for name, col in Z_DEFINITIONS.items():
-        ax.errorbar(fig2["theta_crit"], fig2[col], yerr=fig2[f"{col}_sd"].fillna(0.0), marker="o",
-                    ms=3, capsize=2, label=f"<Z> {name}")
-    _rolling_axis(ax, thetas)
-    ax.set_ylabel("<Z>_0, 2 um, 1 m/s")
-    ax.legend(fontsize=6)
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    cols = KEYS + ["runs"] + [c for m in MEASURES for c in (m, f"{m}_sd")]
-    return fg.save(fig, out / "phi0_question.png", t[cols])

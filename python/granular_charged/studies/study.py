@@ -16,8 +16,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .. import figures
 from ..analysis import tables
+from ..figures.plan import all_figures
 from ..run.after_formation import load_table2
 from .engine import MIN_MINUTES, Engine, deposition_cases, table2_case
 from ..params import DepositionParams
@@ -112,7 +112,7 @@ class Study:
                "have_fmm": have_fmm, **self.analyse(runs, summ, out, results)}
         res["table2"] = tables.table2_frame(t2) if t2 else None
         res["table2_rows"] = t2
-        res["figures"] = figures.all_figures(results, out / "figures", t2, jobs=self.jobs)
+        res["figures"] = all_figures(results, out / "figures", t2, jobs=self.jobs)
         res["wall_s"] = time.monotonic() - t0
         res["complete"] = len(results) == len(params)
         res["missing"] = len(params) - len(results)

@@ -14,10 +14,10 @@ import logging
 import tomllib
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
-from ..analysis import packing
+from ..analysis.tables import grid_value
+from ..figures.studyfile import study_figures
 from ..params import DepositionParams, ParamError, param_names
 from ..run import population
 from ..run.runner import RESERVED
@@ -97,12 +97,6 @@ def params(d: dict) -> list[DepositionParams]:
     return list({p.key(): p for p in out}.values())
 
 
-def grid_value(r: dict, name: str):
-    """The value of a grid axis in a result (a field, or a deck variable of params.extra)."""
-    p = r["params"]
-    return p[name] if name in p else (p.get("extra") or {}).get(name)
-
-
 def tables(d: dict, results: list[dict], out: Path):
     """runs.csv, summary.csv (mean +- sd over the seeds per grid point) and classes.csv."""
     names = list(d.get("grid", {}))
@@ -140,77 +134,6 @@ def tables(d: dict, results: list[dict], out: Path):
     return runs, summ
 
 
-def study_label(d: dict, results: list[dict]) -> str:
-    """The figures' title: the study's name, its material (what differs from the paper's, the
-    population's rules, gamma, U0), the protocols and N."""
-    if not results:
-        return d["name"]
-    from ..figures import material_label
-    p0 = results[0]["params"]
-    protos = sorted({str(r.get("protocol")) for r in results})
-    mat = ", ".join(x for x in (material_label(results), f"gamma {p0['gamma']:g}",
-                                f"U0 {p0['U0']:g}") if x)
-    return f"{d['name']} ({mat}; {', '.join(protos)}; N = {p0['N']})"
-
-
-def figures(d: dict, results: list[dict], out: Path) -> list[Path]:
-    """The study's figures, each titled with its name and protocol (no paper annotation)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    out.mkdir(parents=True, exist_ok=True)
-    label = study_label(d, results)
-    name = d["name"]
-    paths = []
-    for axis in d.get("grid", {}):
-        xs = sorted({grid_value(r, axis) for r in results}, key=lambda v: float(v))
-        fig, (a1, a2) = plt.subplots(1, 2, figsize=(8, 3.4))
-        for ax, k in ((a1, "phi"), (a2, "Z")):
-            m = [np.nanmean([r[k] for r in results if grid_value(r, axis) == x and r[k] is not None] or [np.nan]) for x in xs]
-            s = [np.nanstd([r[k] for r in results if grid_value(r, axis) == x and r[k] is not None] or [np.nan], ddof=1) if
-                 sum(grid_value(r, axis) == x for r in results) > 1 else 0.0 for x in xs]
-            ax.errorbar([float(x) for x in xs], m, yerr=s, marker="o", capsize=3)
-            ax.set_xlabel(axis)
-            ax.set_ylabel("phi" if k == "phi" else "<Z>")
-        fig.suptitle(f"{label}\nmean +- sd over the seeds", fontsize=8)
-        fig.tight_layout()
-        paths.append(out / f"phi_Z_vs_{axis}.png")
-        fig.savefig(paths[-1], dpi=120)
-        plt.close(fig)
-    # f(Z) and g(r) of the first seed of each grid point
-    first = {}
-    for r in results:
-        first.setdefault(tuple(grid_value(r, a) for a in d.get("grid", {})), r)
-    fig, (a1, a2, a3) = plt.subplots(1, 3, figsize=(12, 3.4))
-    for key, r in first.items():
-        lab = ", ".join(f"{a} = {v}" for a, v in zip(d.get("grid", {}), key)) or name
-        if r["fZ"]:
-            a1.plot(range(len(r["fZ"])), r["fZ"], marker=".", label=lab)
-        snap = packing.read_dump(Path(r["dir"]) / "final.dump", last_only=True)
-        zlo, zhi = r["zlo"], r["zhi"]
-        if zhi is None or zlo is None or zhi <= zlo:
-            continue
-        dm = 2.0 * snap["radius"][(snap["z"] >= zlo) & (snap["z"] <= zhi)].mean()
-        rc, g = packing.rdf_slab(snap, zlo, zhi, 4.0 * dm, 120)
-        a2.plot(rc / dm, g, lw=0.8, label=lab)
-        xc, gx = packing.rdf_contact(snap, zlo, zhi, 4.0, 120)
-        a3.plot(xc, gx, lw=0.8, label=lab)
-    a1.set_xlabel("Z")
-    a1.set_ylabel("f(Z)")
-    a1.set_xlim(-0.5, 10.5)
-    a2.set_xlabel("r / <d>")
-    a2.set_ylabel("g(r)")
-    a3.set_xlabel("r / (r_i + r_j)")
-    a3.set_ylabel("g")
-    a1.legend(fontsize=6)
-    fig.suptitle(f"{label}\nf(Z) and g(r) of the analysis slab (first seed)", fontsize=8)
-    fig.tight_layout()
-    paths.append(out / "fZ_gr.png")
-    fig.savefig(paths[-1], dpi=120)
-    plt.close(fig)
-    return paths
-
-
 def run(path, runner, jobs: int = 1, progress: bool = True, engine=None) -> dict:
     """Run a study file: the runs (resumable), then tables and figures under its out folder."""
     d = load(path)
@@ -223,6 +146,6 @@ def run(path, runner, jobs: int = 1, progress: bool = True, engine=None) -> dict
     results = Sweep(runner, out / "runs", jobs=jobs, progress=progress, engine=engine).run(ps)
     out.mkdir(parents=True, exist_ok=True)
     runs, summ = tables(d, results, out)
-    figs = figures(d, results, out / "figures") if results else []
+    figs = study_figures(d, results, out / "figures") if results else []
     return {"study": d, "results": results, "runs": runs, "summary": summ, "figures": figs,
             "complete": len(results) == len(ps)}
