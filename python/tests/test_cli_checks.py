@@ -115,11 +115,11 @@ def test_deck_variables_come_from_the_deck_file(monkeypatch):
     assert "dp" not in real and "contact" not in real       # equal/string: not settable
     monkeypatch.setattr(deckfile, "deck_variables",
                         lambda name: dict(real, pair_suffix="none"))
-    from granular_charged import cli
+    from granular_charged.cli import options
 
     class A:
         var = [["pair_suffix", "opt"]]
-    assert cli._vars(A, "run") == ({}, {"pair_suffix": "opt"})
+    assert options.deck_vars(A, "run") == ({}, {"pair_suffix": "opt"})
     with pytest.raises(ParamError):
         runner.Runner.check(DepositionParams(extra={"pair_sufix": "opt"}))
 
@@ -297,6 +297,21 @@ def test_package_imports_have_no_cycle():
         state[m] = 2
     for m in sorted(graph):
         visit(m, [])
+
+
+def test_package_roles_import_downwards():
+    """The roles of doc/python.md, "Package layout": analysis needs only the parameters and the
+    paper's numbers; running one case needs no study, figure or command line; figures need no
+    run and no command line; the sub-packages import nothing from the command line."""
+    allowed = {"analysis": {"analysis", "params", "paper"},
+               "run": {"run", "analysis", "params", "paper"},
+               "figures": {"figures", "analysis", "studies", "params", "paper"},
+               "studies": {"studies", "run", "analysis", "figures", "params", "paper"}}
+    for mod, deps in _import_graph().items():
+        role = mod.split(".")[1] if mod.count(".") >= 1 else ""
+        if role in allowed:
+            used = {d.split(".")[1] for d in deps if d.count(".") >= 1}
+            assert used <= allowed[role], (mod, used - allowed[role])
 
 
 def test_constants_have_one_home():

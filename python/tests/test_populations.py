@@ -72,10 +72,11 @@ def test_protocol_rule_follows_the_population():
 
 
 def test_var_axes_are_a_product_with_the_other_axes():
-    from granular_charged.cli import _refused, sweep_params, var_axes
+    from granular_charged.cli.options import refused
+    from granular_charged.studies.axes import sweep_params, var_axes
     single, axes = var_axes([["E", "1e8", "2e8"], ["L_rp", "14"], ["gap_rp", "1", "2"]], "sweep")
     ps = sweep_params([dict(rp=[2e-6], U0=[1.0], gamma=[0.01], q=[0.0, 100.0])], single, axes,
-                      {}, _refused("sweep"), 50, [1, 2])
+                      {}, refused("sweep"), 50, [1, 2])
     assert len(ps) == 2 * 2 * 2 * 2 and len({p.key() for p in ps}) == 16
     assert {p.E for p in ps} == {1e8, 2e8} and {p.extra["gap_rp"] for p in ps} == {"1", "2"}
     with pytest.raises(ParamError):

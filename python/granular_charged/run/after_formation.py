@@ -10,7 +10,6 @@ import json
 import logging
 from pathlib import Path
 
-from ..analysis import tables
 from .deckfile import deck_variables
 from ..params import ParamError, coulomb_to_adhesion
 from .runner import RunError, Runner, load_result_files, read_result, write_json
@@ -76,6 +75,8 @@ def run_table2(runner: Runner, formed: Path, qs, out: Path, extra: dict | None =
 
     rows = [run_one(q) for q in qs]
     tmp = out / "table2.csv.tmp"
+    # pandas only when a check's table is written: the command line starts without it
+    from ..analysis import tables
     tables.table2_frame(rows).to_csv(tmp, index=False)
     tmp.replace(out / "table2.csv")
     return rows
