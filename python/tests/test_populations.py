@@ -3,11 +3,8 @@ progress lines, --var axes, study files, the polydisperse analysis and the powde
 
 The LAMMPS runs are small (N <= 120 in L = 9-10 r_p) and short (settle_max 100): they test the
 draws and the bookkeeping, not the packing's statistics."""
-import os
 import re
-import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,26 +13,7 @@ from granular_charged.analysis import packing
 from granular_charged.figures.studyfile import study_label
 from granular_charged.params import DepositionParams, ParamError
 from granular_charged.run import population
-
-SRC = Path(__file__).resolve().parents[2]
-DECK = SRC / "python" / "granular_charged" / "decks" / "in.deposition"
-
-
-def lmp_run(build_dir, deck, cwd, variables, timeout=600):
-    cmd = [str(Path(build_dir) / "lmp"), "-in", str(deck), "-screen", "none", "-log", "log.lammps"]
-    for k, v in variables.items():
-        cmd += ["-var", k, str(v)]
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    r = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
-    text = (Path(cwd) / "log.lammps").read_text()
-    assert r.returncode == 0, text[-3000:] + r.stderr[-2000:]
-    return text
-
-
-def result_line(text):
-    m = re.search(r"^GC RESULT (.*)$", text, re.M)
-    w = m.group(1).split()
-    return dict(zip(w[0::2], w[1::2]))
+from lammps_runs import SRC, lmp_run
 
 
 # ---- without LAMMPS ---------------------------------------------------------------------------
