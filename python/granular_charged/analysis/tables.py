@@ -6,6 +6,7 @@ from scipy.stats import bootstrap
 import pandas as pd
 
 from .. import paper
+from ..params import MATERIAL, DepositionParams, ParamError
 
 CASE = ("rp_um", "U0", "gamma_mJ", "q")    # a case of one variant: everything but the seed
 
@@ -23,7 +24,6 @@ def variant(params: dict) -> str:
     defaults, the other deck variables. The tables average over the seeds of a case, so they
     may hold runs of one variant only (a folder can hold several: the paper-size runs, the
     rolling-limit and the one-at-a-time studies share one)."""
-    from ..params import MATERIAL, DepositionParams
     parts = [f"N={_value(params['N'])}"]
     parts += [f"{k}={_value(params[k])}" for k in MATERIAL
               if k in params and params[k] != getattr(DepositionParams, k)]
@@ -35,7 +35,6 @@ def one_variant(results: list[dict], chosen: str | None = None) -> list[dict]:
     """The results of one variant: all of them when they are of one, else those of `chosen`;
     ParamError naming the variants (with their run counts) when several are there and none,
     or one that is not there, is chosen."""
-    from ..params import ParamError
     groups: dict[str, list[dict]] = {}
     for r in results:
         groups.setdefault(variant(r["params"]), []).append(r)

@@ -13,6 +13,7 @@ import math
 import os
 import sys
 import threading
+import time
 
 from ..paper import Z_COLORS
 
@@ -121,7 +122,6 @@ def watch_parent(pid: int, interval: float = 0.5):
         os._exit(3)
 
     def poll():
-        import time
         while _start_time(pid) == born:
             time.sleep(interval)
         os._exit(3)

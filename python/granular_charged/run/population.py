@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 
-from ..params import E0, ParamError, population_charged
+from ..params import E0, DepositionParams, ParamError, population_charged
 
 SIZE_KEYS = {"one": ("r",), "uniform": ("lo", "hi"), "lognormal": ("median", "gsd", "lo", "hi"),
              "discrete": ("radii", "fractions")}
@@ -189,14 +189,13 @@ def _get(vars_: dict, name: str, s: int, default):
 def describe(vars_: dict) -> dict:
     """The population of a run from its deck variables (DepositionParams.deck_vars()):
     {'species': [{'fraction', 'size', 'charge', 'material'}...]}; the record of result.json."""
-    from ..params import DepositionParams as D
     n = int(float(vars_.get("species", 1)))
     fr = [float(vars_.get("frac" if s == 1 else f"frac_{s}", 1.0)) for s in range(1, n + 1)]
     out = []
     for s in range(1, n + 1):
         g = lambda name, default: _get(vars_, name, s, default)
         rd = g("r_dist", "one")
-        rp = float(g("rp", D.rp))
+        rp = float(g("rp", DepositionParams.rp))
         size = {"dist": rd}
         if rd == "one":
             size["r"] = rp
@@ -214,7 +213,7 @@ def describe(vars_: dict) -> dict:
         qd = g("q_dist", "fixed")
         charge = {"dist": qd, "q": float(g("q", 0.0)), "sigma": float(g("q_sigma", 0.0)),
                   "sd": float(g("q_sd", 0.0)), "pos": float(g("q_pos", 0.5))}
-        material = {k: float(g(k, getattr(D, k))) for k in MATERIAL_KEYS}
+        material = {k: float(g(k, getattr(DepositionParams, k))) for k in MATERIAL_KEYS}
         out.append({"fraction": fr[s - 1] / sum(fr), "size": size, "charge": charge,
                     "material": material})
     return {"species": out}

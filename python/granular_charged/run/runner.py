@@ -23,6 +23,7 @@ import resource
 import shutil
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -321,7 +322,6 @@ class Runner:
     def _watch(self, cmd, env, workdir: Path, kind: str) -> subprocess.CompletedProcess:
         """Run the child, following the GC PROGRESS lines of its log.lammps (particles made / N)
         with a tqdm bar when self.show_progress (a deposition); the timeout kills it."""
-        import tempfile
         with tempfile.TemporaryFile("w+") as fo, tempfile.TemporaryFile("w+") as fe:
             proc = subprocess.Popen(cmd, env=env, stdout=fo, stderr=fe, text=True)
             bar = None
