@@ -9,8 +9,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from . import measures, packing, tables
 from .. import paper
+from . import measures, packing, tables
 from .tables import CASE, with_uncertainty
 
 SERIES = ["rp_um", "U0", "gamma_mJ"]

@@ -23,8 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import packing
 from ..params import jkr_scales, pair_modulus
+from . import packing
 
 log = logging.getLogger(__name__)
 

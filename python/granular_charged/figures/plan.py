@@ -10,8 +10,8 @@ import multiprocessing
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from .base import PAPER, biggest_series, finished, material_label
 from .adhesion import vs_adstar
+from .base import PAPER, biggest_series, finished, material_label
 from .conventions import conventions
 from .expansion import phi_vs_q, table2
 from .forces import force_network, force_pdf

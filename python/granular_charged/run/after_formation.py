@@ -10,8 +10,8 @@ import json
 import logging
 from pathlib import Path
 
-from .deckfile import deck_variables
 from ..params import ParamError, coulomb_to_adhesion
+from .deckfile import deck_variables
 from .runner import RunError, Runner, load_result_files, read_result, write_json
 
 DECK = "in.charged-after-formation"

@@ -14,8 +14,8 @@ import json
 import math
 from pathlib import Path
 
-from . import population
 from ..params import DepositionParams, time_step
+from . import population
 
 # when no finished run is found: c of the kept runs of this package (neutral, charged) and a
 # factor 3 either way

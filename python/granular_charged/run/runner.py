@@ -28,11 +28,11 @@ import time
 from pathlib import Path
 
 from ..analysis import packing
+from ..params import DepositionParams, ParamError, coulomb_to_adhesion
 from . import population
 from .deckfile import deck_path, deck_variables
 from .lammps_build import LammpsBuild
 from .logs import read_new_lines
-from ..params import DepositionParams, ParamError, coulomb_to_adhesion
 
 log = logging.getLogger(__name__)
 

@@ -31,8 +31,8 @@ import itertools
 import numpy as np
 import pandas as pd
 
-from ..analysis import measures, tables
 from .. import paper
+from ..analysis import measures, tables
 from ..params import DepositionParams
 
 GAMMA = 0.010

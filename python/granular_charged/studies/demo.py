@@ -13,8 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
-from ..analysis import claims, tables
 from .. import paper
+from ..analysis import claims, tables
 from ..params import DepositionParams
 from .study import Study
 

@@ -23,10 +23,10 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from ..analysis import claims, tables
 from .. import paper
-from .demo import STUDY_INJECTION
+from ..analysis import claims, tables
 from ..params import DepositionParams
+from .demo import STUDY_INJECTION
 from .study import Study
 from .sweep import PAPER_SETS, expand
 

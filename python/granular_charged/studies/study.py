@@ -18,10 +18,10 @@ from pathlib import Path
 
 from ..analysis import tables
 from ..figures.plan import all_figures
-from ..run.after_formation import load_table2
-from .engine import MIN_MINUTES, Engine, deposition_cases, table2_case
 from ..params import DepositionParams
+from ..run.after_formation import load_table2
 from ..run.runner import Runner
+from .engine import MIN_MINUTES, Engine, deposition_cases, table2_case
 from .sweep import describe_result, finished_results
 
 log = logging.getLogger(__name__)

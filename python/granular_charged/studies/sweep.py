@@ -13,9 +13,9 @@ import logging
 from pathlib import Path
 from types import MappingProxyType
 
-from .engine import Engine, deposition_cases
 from ..params import DepositionParams
 from ..run.runner import Runner, load_result_files, read_result
+from .engine import Engine, deposition_cases
 
 log = logging.getLogger(__name__)
 
