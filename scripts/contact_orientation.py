@@ -15,7 +15,8 @@ from pathlib import Path
 import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "python"))
-from granular_charged import epd, tables  # noqa: E402
+from granular_charged.studies import epd  # noqa: E402
+from granular_charged.analysis import tables  # noqa: E402
 
 
 def main(dirs: list[str]) -> int:

@@ -34,8 +34,8 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "python"))
-from granular_charged import measures  # noqa: E402
-from granular_charged.runner import read_result  # noqa: E402
+from granular_charged.analysis import measures  # noqa: E402
+from granular_charged.run.runner import read_result  # noqa: E402
 
 PLAIN = ("result.json", "measures.json")
 COMPRESSED = ("final.dump", "forces.dump")
@@ -95,7 +95,7 @@ POINT_FILES = ("checkpoint.vars", "pieces.json", "tracer.dump")
 def keep_points(src: Path, dst: Path) -> int:
     """The latest restart point of each unfinished run of src into dst/<run>/ (see --points)."""
     import json
-    from granular_charged.runner import CHECKPOINT_VARS, close_interrupted_pieces, restart_point
+    from granular_charged.run.runner import CHECKPOINT_VARS, close_interrupted_pieces, restart_point
     kept = 0
     for run in sorted(p for p in src.iterdir() if p.is_dir()):
         target = dst / run.name
@@ -140,7 +140,7 @@ def keep_points(src: Path, dst: Path) -> int:
 
 def unpack_points(src: Path, dst: Path) -> int:
     """Kept restart points of src back into the run folders of dst, decompressed."""
-    from granular_charged.runner import restart_point
+    from granular_charged.run.runner import restart_point
     unpacked = 0
     for kept in sorted(p for p in src.iterdir() if p.is_dir() and not p.name.startswith(".")):
         point = restart_point(kept, ".gz")
@@ -167,7 +167,7 @@ TABLE2_DUMPS = ("before.dump", "after.dump", "forces_before.dump", "forces_after
 
 def keep_table2(src: Path, dst: Path) -> int:
     """The Table 2 runs (STUDY_OUT/table2/q*/): result.json and the four dumps, compressed."""
-    from granular_charged.after_formation import row_problem
+    from granular_charged.run.after_formation import row_problem
     import json
     kept = 0
     for run in sorted(src.glob("q*")):

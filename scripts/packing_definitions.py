@@ -9,7 +9,7 @@ rattlers) and over all particles (with or without floor contacts). doc/reproduct
 import glob, sys, statistics as st
 import numpy as np
 sys.path.insert(0, str(__import__('pathlib').Path(__file__).resolve().parents[1] / 'python'))
-from granular_charged import measures, packing
+from granular_charged.analysis import measures, packing
 
 rows = {}
 part = sys.argv[2] if len(sys.argv) > 2 else ''

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
-from granular_charged import packing  # noqa: E402
+from granular_charged.analysis import packing  # noqa: E402
 from granular_charged.params import jkr_scales, pair_modulus  # noqa: E402
 
 

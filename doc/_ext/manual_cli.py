@@ -18,8 +18,8 @@ def _escape(text):
 
 
 def _escape_parser(parser, done):
-    # the common options are one set of action objects shared by every sub-command's parser
-    # (argparse's parents=): each object is escaped once
+    # argparse's parents= lets several parsers hold one action object: each object is
+    # escaped once
     if id(parser) in done:
         return
     done.add(id(parser))

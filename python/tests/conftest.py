@@ -1,6 +1,5 @@
-"""Shared fixtures. The LAMMPS build is found through $GC_BUILD_DIR (set by ctest's
-python.pytest), else the lammps module on PYTHONPATH, else <source>/build; a missing build FAILS
-the tests that need it (nothing is skipped silently).
+"""Shared fixtures: build_dir (lammps_runs.py, shared with tests_powder) and cli, the command
+line run in a folder.
 
 Only one LAMMPS run at a time (the runs are sequential): the CI machine has two cores."""
 import os
@@ -10,17 +9,7 @@ from pathlib import Path
 
 import pytest
 
-SRC = Path(os.environ.get("GC_SOURCE_DIR", Path(__file__).resolve().parents[2]))
-sys.path.insert(0, str(SRC / "python"))
-
-
-@pytest.fixture(scope="session")
-def build_dir():
-    from granular_charged.lammps_build import BuildError, locate_build
-    try:
-        return locate_build(os.environ.get("GC_BUILD_DIR"))
-    except BuildError as e:
-        pytest.fail(f"LAMMPS build needed (set GC_BUILD_DIR): {e}")
+from lammps_runs import SRC, build_dir  # noqa: F401 (build_dir: the fixture, shared)
 
 
 @pytest.fixture(scope="session")

@@ -38,7 +38,7 @@ def _popen(build_dir, args, cwd):
 
 
 def _restart_particle(wd: Path) -> int:
-    from granular_charged.runner import restart_point
+    from granular_charged.run.runner import restart_point
     point = restart_point(wd)
     return point["k"] if point else 0
 

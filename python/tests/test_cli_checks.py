@@ -18,7 +18,10 @@ import numpy as np
 import pytest
 
 from conftest import SRC
-from granular_charged import deckfile, params, runner, sweep, tables
+from granular_charged.run import deckfile, runner
+from granular_charged import params
+from granular_charged.studies import sweep
+from granular_charged.analysis import tables
 from granular_charged.params import DepositionParams, ParamError
 
 
@@ -112,11 +115,11 @@ def test_deck_variables_come_from_the_deck_file(monkeypatch):
     assert "dp" not in real and "contact" not in real       # equal/string: not settable
     monkeypatch.setattr(deckfile, "deck_variables",
                         lambda name: dict(real, pair_suffix="none"))
-    from granular_charged import cli
+    from granular_charged.cli import options
 
     class A:
         var = [["pair_suffix", "opt"]]
-    assert cli._vars(A, "run") == ({}, {"pair_suffix": "opt"})
+    assert options.deck_vars(A, "run") == ({}, {"pair_suffix": "opt"})
     with pytest.raises(ParamError):
         runner.Runner.check(DepositionParams(extra={"pair_sufix": "opt"}))
 
@@ -199,7 +202,7 @@ def test_figures_of_broken_results_is_an_error_not_a_traceback(tmp_path):
 
 
 def test_table2_rows_with_missing_keys_are_left_out(tmp_path, caplog):
-    from granular_charged.after_formation import load_table2
+    from granular_charged.run.after_formation import load_table2
     (tmp_path / "q0").mkdir()
     (tmp_path / "q0" / "result.json").write_text(json.dumps({"q": 0.0}))
     assert load_table2(tmp_path) == [] and "keys missing: phi_before" in caplog.text
@@ -248,24 +251,39 @@ def test_folder_lock_makes_a_second_process_wait(tmp_path, caplog):
 
 
 # ---- item 12: no import cycle ----------------------------------------------------------------
-def _imports(path: Path) -> set:
+PKG = SRC / "python" / "granular_charged"
+
+
+def _module_name(path: Path) -> str:
+    parts = path.relative_to(PKG.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _imports(path: Path, modules: set) -> set:
     """The package modules a module imports (at any level, also inside functions)."""
+    name = _module_name(path)
+    here = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
     out = set()
     for node in ast.walk(ast.parse(path.read_text())):
-        if isinstance(node, ast.ImportFrom) and node.level == 1:
-            if node.module:
-                out.add(node.module.split(".")[0])
-            else:
-                out.update(a.name for a in node.names)
-    return out
+        if isinstance(node, ast.ImportFrom) and node.level >= 1:
+            base = ".".join(here[:len(here) - node.level + 1] + ([node.module] if node.module else []))
+            for a in node.names:
+                out.add(f"{base}.{a.name}" if f"{base}.{a.name}" in modules else base)
+    return out & modules
+
+
+def _import_graph() -> dict:
+    files = sorted(PKG.rglob("*.py"))
+    modules = {_module_name(f) for f in files}
+    return {_module_name(f): _imports(f, modules) - {_module_name(f)} for f in files}
 
 
 def test_package_imports_have_no_cycle():
-    pkg = SRC / "python" / "granular_charged"
-    graph = {f.stem: _imports(f) - {f.stem} for f in pkg.glob("*.py")}
-    graph = {k: {m for m in v if m in graph} for k, v in graph.items()}
+    graph = _import_graph()
     # only the entry point imports the command line
-    assert {k for k, v in graph.items() if "cli" in v} == {"__main__"}
+    cli = "granular_charged.cli"
+    assert {k for k, v in graph.items() if not k.startswith(cli)
+            and any(m == cli or m.startswith(cli + ".") for m in v)} == {"granular_charged.__main__"}
     state = {}
 
     def visit(m, path):
@@ -281,13 +299,30 @@ def test_package_imports_have_no_cycle():
         visit(m, [])
 
 
+def test_package_roles_import_downwards():
+    """The roles of doc/python.md, "Package layout": analysis needs only the parameters and the
+    paper's numbers; running one case needs no study, figure or command line; figures need no
+    run and no command line; the sub-packages import nothing from the command line."""
+    allowed = {"analysis": {"analysis", "params", "paper"},
+               "run": {"run", "analysis", "params", "paper"},
+               "figures": {"figures", "analysis", "studies", "params", "paper"},
+               "studies": {"studies", "run", "analysis", "figures", "params", "paper"}}
+    for mod, deps in _import_graph().items():
+        role = mod.split(".")[1] if mod.count(".") >= 1 else ""
+        if role in allowed:
+            used = {d.split(".")[1] for d in deps if d.count(".") >= 1}
+            assert used <= allowed[role], (mod, used - allowed[role])
+
+
 def test_constants_have_one_home():
-    pkg = SRC / "python" / "granular_charged"
-    text = {f.name: f.read_text() for f in pkg.glob("*.py")}
-    for name, home in (("K_EFF", "paper.py"), ("ZMAX", "packing.py")):
+    text = {f.relative_to(PKG).as_posix(): f.read_text() for f in PKG.rglob("*.py")}
+    for name, home in (("K_EFF", "paper.py"), ("ZMAX", "analysis/packing.py")):
         defs = [f for f, t in text.items()
                 for node in ast.walk(ast.parse(t)) if isinstance(node, ast.Assign)
                 for tgt in node.targets if isinstance(tgt, ast.Name) and name in tgt.id]
         assert defs == [home], (name, defs)
-    for legacy in ("demo.py", "sweep.py", "reproduce.py", "after_formation.py", "cli.py"):
-        assert '__name__ == "__main__"' not in text[legacy], legacy
+    legacy = [f for f in text if Path(f).name in ("demo.py", "sweep.py", "reproduce.py",
+                                                 "after_formation.py") or f.startswith("cli")]
+    assert len(legacy) >= 5, legacy
+    for f in legacy:
+        assert '__name__ == "__main__"' not in text[f], f

@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from granular_charged.deckfile import deck_variables
+from granular_charged.run.deckfile import deck_variables
 from granular_charged.params import DepositionParams, split_deck_vars
-from granular_charged.runner import read_result, write_json
+from granular_charged.run.runner import read_result, write_json
 
 TINY = ["--N", 10, "--var", "L_rp", 6, "--var", "H_rp", 60, "--no-render"]
 

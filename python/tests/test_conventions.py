@@ -1,12 +1,15 @@
-"""The phi_0 question's study (granular_charged.conventions): its runs, its per-case means and
+"""The phi_0 question's study (granular_charged.studies.conventions): its runs, its per-case means and
 its three checks against the paper's printed numbers, on runs with known measures."""
 import json
 
 import numpy as np
 import pytest
 
-from granular_charged import conventions, measures, paper
-from granular_charged.reproduce import paper_size_params
+from granular_charged import paper
+from granular_charged.analysis import measures
+from granular_charged.figures.conventions import phi0_question
+from granular_charged.studies import conventions
+from granular_charged.studies.reproduce import paper_size_params
 
 
 def _result(tmp_path, theta, rp, u0, q, seed, phi, Z, surface=None, top=None, Z_all=None):
@@ -76,7 +79,7 @@ def test_case_means_and_the_three_checks(tmp_path):
     text = conventions.format_checks(c.reset_index())
     assert "0.3249 +- 0.0020" in text and "0.300-0.340" in text
     # the figure: the paper's numbers beside ours, the plotted means as CSV
-    path = conventions.figure(t, tmp_path / "fig")
+    path = phi0_question(t, tmp_path / "fig")
     assert path.stat().st_size > 10000
     import pandas as pd
     assert len(pd.read_csv(path.with_suffix(".csv"))) == len(t)

@@ -31,7 +31,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from granular_charged import packing
+from granular_charged.analysis import packing
 from granular_charged.params import jkr_scales, pair_modulus
 
 N, TRACER = 40, 30

@@ -1,10 +1,11 @@
-"""The EPD study's table (granular_charged.epd) on runs with known contacts, and its run list."""
+"""The EPD study's table (granular_charged.studies.epd) on runs with known contacts, and its run list."""
 import json
 
 import numpy as np
 import pytest
 
-from granular_charged import epd
+from granular_charged.figures.epd import epd_figures
+from granular_charged.studies import epd
 
 
 def _layers(path, nlayers):
@@ -69,7 +70,7 @@ def test_figures_draw_every_case_and_the_orientation(tmp_path):
     for r in rs:
         r["params"]["q"] = 400.0
         r["natoms"] = 16
-    paths = epd.figures(rs, tmp_path / "figures")
+    paths = epd_figures(rs, tmp_path / "figures")
     assert [p.name for p in paths] == ["packings.png", "orientation.png"]
     assert all(p.stat().st_size > 10000 for p in paths)
     import pandas as pd

@@ -1,11 +1,11 @@
-"""The per-run measures of the paper's claims (granular_charged.measures) on inputs with known
+"""The per-run measures of the paper's claims (granular_charged.analysis.measures) on inputs with known
 answers."""
 import math
 
 import numpy as np
 import pytest
 
-from granular_charged import measures, packing
+from granular_charged.analysis import measures, packing
 
 
 def test_rdf_peak_area_of_a_gaussian_on_a_sloping_background():

@@ -1,10 +1,10 @@
-"""The one-at-a-time study's tables (granular_charged.one_at_a_time) on made-up results: which
+"""The one-at-a-time study's tables (granular_charged.studies.one_at_a_time) on made-up results: which
 runs it asks for, the protocol of a run, phi_0/phi - 1 against the neutral runs, and the
 differences between the protocols in standard errors. No LAMMPS."""
 import numpy as np
 import pytest
 
-from granular_charged import one_at_a_time as oat
+from granular_charged.studies import one_at_a_time as oat
 
 
 def _result(q, seed, phi, Z, inject=None):

@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from granular_charged import packing
+from granular_charged.analysis import packing
 
 
 def snap_from(x, y, z, r, L, H):

@@ -3,36 +3,17 @@ progress lines, --var axes, study files, the polydisperse analysis and the powde
 
 The LAMMPS runs are small (N <= 120 in L = 9-10 r_p) and short (settle_max 100): they test the
 draws and the bookkeeping, not the packing's statistics."""
-import os
 import re
-import subprocess
-from pathlib import Path
+import sys
 
 import numpy as np
 import pytest
 
-from granular_charged import packing, population
+from granular_charged.analysis import packing
+from granular_charged.figures.studyfile import study_label
 from granular_charged.params import DepositionParams, ParamError
-
-SRC = Path(__file__).resolve().parents[2]
-DECK = SRC / "python" / "granular_charged" / "decks" / "in.deposition"
-
-
-def lmp_run(build_dir, deck, cwd, variables, timeout=600):
-    cmd = [str(Path(build_dir) / "lmp"), "-in", str(deck), "-screen", "none", "-log", "log.lammps"]
-    for k, v in variables.items():
-        cmd += ["-var", k, str(v)]
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    r = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
-    text = (Path(cwd) / "log.lammps").read_text()
-    assert r.returncode == 0, text[-3000:] + r.stderr[-2000:]
-    return text
-
-
-def result_line(text):
-    m = re.search(r"^GC RESULT (.*)$", text, re.M)
-    w = m.group(1).split()
-    return dict(zip(w[0::2], w[1::2]))
+from granular_charged.run import population
+from lammps_runs import SRC, lmp_run
 
 
 # ---- without LAMMPS ---------------------------------------------------------------------------
@@ -69,10 +50,11 @@ def test_protocol_rule_follows_the_population():
 
 
 def test_var_axes_are_a_product_with_the_other_axes():
-    from granular_charged.cli import _refused, sweep_params, var_axes
+    from granular_charged.cli.options import refused
+    from granular_charged.studies.axes import sweep_params, var_axes
     single, axes = var_axes([["E", "1e8", "2e8"], ["L_rp", "14"], ["gap_rp", "1", "2"]], "sweep")
     ps = sweep_params([dict(rp=[2e-6], U0=[1.0], gamma=[0.01], q=[0.0, 100.0])], single, axes,
-                      {}, _refused("sweep"), 50, [1, 2])
+                      {}, refused("sweep"), 50, [1, 2])
     assert len(ps) == 2 * 2 * 2 * 2 and len({p.key() for p in ps}) == 16
     assert {p.E for p in ps} == {1e8, 2e8} and {p.extra["gap_rp"] for p in ps} == {"1", "2"}
     with pytest.raises(ParamError):
@@ -80,8 +62,8 @@ def test_var_axes_are_a_product_with_the_other_axes():
 
 
 def test_study_file_grid_seeds_and_protocol_warning(tmp_path, caplog):
-    from granular_charged import studyfile
-    from granular_charged.axes import announce
+    from granular_charged.studies import studyfile
+    from granular_charged.studies.axes import announce
     f = tmp_path / "s.toml"
     f.write_text('name = "my dust"\nseeds = [1, 2, 3]\n[deck]\nU0 = 0.5\nN = 40\n'
                  '[material]\nrho = 3000\nE = 1e8\ngamma = 0.02\n'
@@ -103,7 +85,7 @@ def test_study_file_grid_seeds_and_protocol_warning(tmp_path, caplog):
     assert "estimated cost" in caplog.text
     # the figures' title names the study and its material
     fake = [{"params": dict(vars(p), extra=dict(p.extra)), "protocol": "plane"} for p in ps]
-    label = studyfile.study_label(d, fake)
+    label = study_label(d, fake)
     assert label.startswith("my dust (rho 3000, E 1e+08, uniform radii, area charges, gamma 0.02")
     assert "paper" not in label
 
@@ -138,7 +120,6 @@ def test_powder_example_short_version(build_dir, tmp_path):
 
 def _figure_texts(monkeypatch, fn, results, out):
     """Every text (titles, labels, legend entries) of the figures fn draws from results."""
-    from granular_charged import figures
     texts = []
 
     def capture(fig, path, data=None, tight=True):
@@ -148,7 +129,7 @@ def _figure_texts(monkeypatch, fn, results, out):
         plt.close(fig)
         return path
 
-    monkeypatch.setattr(figures, "save", capture)
+    monkeypatch.setattr(sys.modules[fn.__module__], "save", capture)
     fn(results, out)
     return " ".join(texts)
 
@@ -157,31 +138,31 @@ def test_figures_carry_the_users_material_not_the_paper(monkeypatch, tmp_path):
     """The paper's annotations only on the paper's material; a user's runs are labelled with
     theirs (all_figures decides; rdf and fZ are drawn here from two kept paper-size runs)."""
     import copy
-    from granular_charged import figures
-    from granular_charged.runner import load_result_files
+    from granular_charged.figures import base, expansion, structure
+    from granular_charged.run.runner import load_result_files
     kept = SRC / "doc" / "data" / "paper-size" / "runs"
     res = load_result_files([kept / "rp2um_U1_g10mJ_q0_N2000_s1" / "result.json",
                              kept / "rp2um_U1_g10mJ_q400_N2000_s1_exact" / "result.json"])
     assert len(res) == 2
-    figures.PAPER.update(on=not figures.material_label(res), material=figures.material_label(res))
-    assert "paper" in _figure_texts(monkeypatch, figures.rdf, res, tmp_path)
+    base.PAPER.update(on=not base.material_label(res), material=base.material_label(res))
+    assert "paper" in _figure_texts(monkeypatch, structure.rdf, res, tmp_path)
     mine = copy.deepcopy(res)
     for r in mine:
         r["params"]["rho"] = 3000.0
         r["params"]["extra"] = dict(r["params"].get("extra") or {}, r_dist="uniform")
-    lab = figures.material_label(mine)
+    lab = base.material_label(mine)
     assert lab == "rho 3000, uniform radii"
-    figures.PAPER.update(on=False, material=lab)
-    for fn in (figures.rdf, figures.fZ, figures.phi_vs_q):
+    base.PAPER.update(on=False, material=lab)
+    for fn in (structure.rdf, structure.fZ, expansion.phi_vs_q):
         t = _figure_texts(monkeypatch, fn, mine, tmp_path)
         assert "paper" not in t.lower() and "rho 3000" in t, fn.__name__
-    figures.PAPER.update(on=True, material="")
+    base.PAPER.update(on=True, material="")
 
 
 def test_progress_bar_follows_the_log(tmp_path):
     """The run's bar reads the deck's GC PROGRESS lines as log.lammps grows (a partial last line
     is left for the next read)."""
-    from granular_charged.runner import Runner
+    from granular_charged.run.runner import Runner
 
     class Bar:
         total = n = None

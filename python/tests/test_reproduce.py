@@ -3,8 +3,8 @@ what is finished without running anything."""
 import pytest
 
 from granular_charged import paper
-from granular_charged.reproduce import SIZES, Reproduction, paper_size_params
-from granular_charged.sweep import PAPER_SETS, expand
+from granular_charged.studies.reproduce import SIZES, Reproduction, paper_size_params
+from granular_charged.studies.sweep import PAPER_SETS, expand
 
 
 def test_paper_size_runs_are_the_sweep_presets_and_the_fig9_neutral_range():
@@ -47,8 +47,8 @@ def test_finished_only_runs_nothing(cli, tmp_path):
 
 
 def test_paper_size_checks_table2_on_every_seeds_packing(tmp_path):
-    from granular_charged.demo import Demo
-    from granular_charged.study import table2_folder, table2_folders
+    from granular_charged.studies.demo import Demo
+    from granular_charged.studies.study import table2_folder, table2_folders
     assert Reproduction(out=".", size_name="paper").table2_seeds() == (1, 2, 3)
     assert Reproduction(out=".", size_name="demo").table2_seeds() == (1,)
     assert Demo(out=".", seeds=(4, 5)).table2_seeds() == (4,)
@@ -61,7 +61,7 @@ def test_paper_size_checks_table2_on_every_seeds_packing(tmp_path):
 
 
 def test_table2_frame_names_each_packings_seed():
-    from granular_charged import tables
+    from granular_charged.analysis import tables
     rows = [{"q": q, "phi_before": 0.4, "phi_after": 0.4 + dq, "Z_before": 3.9, "Z_after": 3.9,
              "FC_over_FE": 1e4, "params": {"seed": s}}
             for s in (1, 2) for q, dq in ((0.0, 0.0), (400.0, 1e-5))]

@@ -32,7 +32,7 @@ def _popen(build_dir, args, cwd):
 
 
 def _children(workdir: Path) -> list[int]:
-    """Pids of LAMMPS children (python -m granular_charged.child) running in workdir."""
+    """Pids of LAMMPS children (python -m granular_charged.run.child) running in workdir."""
     pids = []
     for d in Path("/proc").iterdir():
         if not d.name.isdigit():
@@ -42,7 +42,7 @@ def _children(workdir: Path) -> list[int]:
             state = (d / "stat").read_text().rsplit(")", 1)[1].split()[0]
         except OSError:
             continue
-        if b"granular_charged.child" in cmd and str(workdir).encode() in cmd and state != "Z":
+        if b"granular_charged.run.child" in cmd and str(workdir).encode() in cmd and state != "Z":
             pids.append(int(d.name))
     return pids
 

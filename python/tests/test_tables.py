@@ -2,7 +2,7 @@
 import numpy as np
 import pandas as pd
 
-from granular_charged import tables
+from granular_charged.analysis import tables
 
 
 def _runs(rows, estar=None):
@@ -141,7 +141,7 @@ def test_one_variant_refuses_to_average_several():
 def test_packing_images_of_several_series_get_their_own_names():
     """The nine neutral cases of the paper-size study are all q = 0, seed 1: with names by q and
     seed only they wrote one file in turn; one series keeps the short names (the demo's)."""
-    from granular_charged.figures import packing_image_names
+    from granular_charged.figures.packings import packing_image_names
     one = [_params(q=q, seed=s) for q in (0.0, 400.0) for s in (1, 2)]
     assert packing_image_names(one) == ["packing_q0_s1.png", "packing_q0_s2.png",
                                         "packing_q400_s1.png", "packing_q400_s2.png"]
@@ -153,7 +153,7 @@ def test_packing_images_of_several_series_get_their_own_names():
 def test_tracer_energy_claim_is_a_mean_over_the_seeds_that_followed_one():
     """The E_k/E_k0 line: mean +- sd and a verdict where several seeds followed a tracer, the
     single value (and no verdict) where one did."""
-    from granular_charged import claims
+    from granular_charged.analysis import claims
     rows = []
     for q, eks in ((0.0, (1.01, 1.00, 1.02)), (260.0, (0.80, np.nan, np.nan)),
                    (400.0, (0.50, 0.55, 0.45))):

@@ -1,11 +1,11 @@
-"""The two-sphere multipole reference (granular_charged.two_spheres) against closed forms: the
+"""The two-sphere multipole reference (granular_charged.analysis.two_spheres) against closed forms: the
 re-expansion pointwise, the point-dipole pair at n_max = 1, and Kelvin's image series for
 touching conducting spheres."""
 import numpy as np
 import pytest
 from scipy.special import lpmv, zeta
 
-from granular_charged import two_spheres as ts
+from granular_charged.analysis import two_spheres as ts
 
 
 @pytest.mark.parametrize("m", [0, 1])

@@ -5,37 +5,15 @@ and Coulomb forces against a direct sum, and a narrow size spread against one si
 
 The runs are small (N = 60-200 in L = 9-10 r_p) and said so in each test."""
 import math
-import os
-import re
-import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy import stats
 
-from granular_charged import packing, population
+from granular_charged.analysis import packing
+from granular_charged.run import population
 from granular_charged.params import E0
-
-SRC = Path(__file__).resolve().parents[2]
-DECK = SRC / "python" / "granular_charged" / "decks" / "in.deposition"
-
-
-def lmp_run(build_dir, deck, cwd, variables, timeout=900):
-    cmd = [str(Path(build_dir) / "lmp"), "-in", str(deck), "-screen", "none", "-log", "log.lammps"]
-    for k, v in variables.items():
-        cmd += ["-var", k, str(v)]
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    r = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
-    text = (Path(cwd) / "log.lammps").read_text()
-    assert r.returncode == 0, text[-3000:] + r.stderr[-2000:]
-    return text
-
-
-def result_line(text):
-    m = re.search(r"^GC RESULT (.*)$", text, re.M)
-    w = m.group(1).split()
-    return dict(zip(w[0::2], w[1::2]))
+from lammps_runs import DECK, lmp_run, result_line
 
 
 @pytest.fixture(scope="module")
@@ -78,7 +56,7 @@ def test_deck_draws_follow_the_requested_distributions(lognormal_gauss_run):
     assert text.count("Loop time") <= 4, "log.lammps holds the one-by-one loop's runs"
     prog = [ln for ln in text.splitlines() if ln.startswith("GC PROGRESS")]
     assert len(prog) >= 10 and prog[-1].startswith("GC PROGRESS 120 / 120")
-    from granular_charged.runner import parse_progress
+    from granular_charged.run.runner import parse_progress
     assert parse_progress(prog[-1])["k"] == 120
 
 

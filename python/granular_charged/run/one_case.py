@@ -1,5 +1,5 @@
 """Run one case of a study's plan: ``python -m granular_charged.run.one_case PLAN FOLDER`` (the job
-of the package's Snakefile, granular_charged.engine). A deposition writes FOLDER/result.json,
+of the package's Snakefile, granular_charged.studies.engine). A deposition writes FOLDER/result.json,
 a Table 2 check FOLDER/table2.csv, each atomically at its end; a case that fails writes its
 error to FOLDER/failed.txt (its target stays missing, so the engine runs it again next time)
 and exits 1."""
@@ -9,15 +9,17 @@ import json
 import sys
 from pathlib import Path
 
-from ..studies.engine import FAILED
+from ..params import DepositionParams, ParamError
+from .after_formation import run_table2
+from .lammps_build import BuildError, LammpsBuild
+from .logs import setup_case_logging
+from .runner import RunError, Runner
+
+# a failed case's error, in its folder (the engine reports it)
+FAILED = "failed.txt"
 
 
 def run(plan_path: str, folder: str) -> int:
-    from ..after_formation import run_table2
-    from ..lammps_build import BuildError, LammpsBuild
-    from ..logs import setup_case_logging
-    from ..params import DepositionParams, ParamError
-    from ..runner import RunError, Runner
     setup_case_logging()
     plan = json.loads(Path(plan_path).read_text())
     job = next(j for j in plan["jobs"] if j["folder"] == folder)

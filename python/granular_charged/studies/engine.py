@@ -34,13 +34,17 @@ from pathlib import Path
 from tqdm import tqdm
 from tqdm.contrib.logging import logging_redirect_tqdm
 
+from ..run.after_formation import table2_complete
+from ..run.estimate import cpu_seconds
+from ..run.logs import read_new_lines, relay_case_line
+from ..run.one_case import FAILED
+from ..run.runner import read_result
+
 log = logging.getLogger(__name__)
 
 SNAKEFILE = Path(__file__).resolve().parent / "Snakefile"
 # the plans and Snakemake's log of each study, inside the study's folder
 PLAN_DIR = ".gc-workflow"
-# a case that failed leaves its error here (its target stays missing: it runs again next time)
-FAILED = "failed.txt"
 LOCKED = "cannot be locked"
 # a Slurm time limit: the estimate's upper bound times this, at least this many minutes
 TIME_MARGIN = 2.0
@@ -285,7 +289,6 @@ def progress(new_done: int, todo: int, total: int, elapsed: float) -> str:
 
 def _relay(logfile: Path, pos: int) -> int:
     """Relay the cases' marked log lines written to Snakemake's log since byte pos."""
-    from ..logs import read_new_lines, relay_case_line
     lines, pos = read_new_lines(logfile, pos)
     for line in lines:
         relay_case_line(line, log)
@@ -330,8 +333,6 @@ def _job_env() -> dict:
 def _drop_unusable(root: Path, case: Case):
     """A target that exists but cannot be used (garbage, an older version, wrong types) is
     removed, so that the engine runs its case again."""
-    from ..after_formation import table2_complete
-    from ..runner import read_result
     path = root / case.target
     if not path.exists():
         return
@@ -355,7 +356,6 @@ def minutes_for(cpu_s: float, factor: float, np_ranks: int) -> int:
 def deposition_cases(params, runs_folder: str, np_ranks: int, tracer=0, calibrate=()) -> list[Case]:
     """The cases of depositions (runs_folder/<key>, relative to the study's root), each with
     its time limit from the cost estimate (estimate.cpu_seconds)."""
-    from ..estimate import cpu_seconds
     costs = cpu_seconds(params, calibrate)
     cases = []
     for p, (cpu, factor) in zip(params, costs):
