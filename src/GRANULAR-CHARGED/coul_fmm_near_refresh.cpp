@@ -105,22 +105,18 @@ void CoulFMMNearRefresh::exchange_displacements(const CoulFMMState &state)
   comm->forward_comm(fix);
 }
 
-// the pairs of charged atoms of the group in the list's order (their j and, per i, where
-// they end): their separations now and at the evaluation, then the kernel differences of all
-// of them in one call (SIMD), then the sums in the same order as pair by pair
-void CoulFMMNearRefresh::compute_all(const MTS &scheme, double trend, double **out)
+bool CoulFMMNearRefresh::charged(int i) const
 {
-  const int nlocal = atom->nlocal;
-  double **x = atom->x, *q = atom->q;
-  int *mask = atom->mask;
-  const int groupbit = fix->groupbit;
-  auto charged = [&](int j) { return (mask[j] & groupbit) && q[j] != 0.0; };
-  int npairs = 0;
-  for (int ii = 0; ii < list->inum; ii++)
-    if (charged(list->ilist[ii])) npairs += list->numneigh[list->ilist[ii]];
-  grow_pairs(npairs);
-  pair_i.clear();
-  int p = 0;
+  return (atom->mask[i] & fix->groupbit) && atom->q[i] != 0.0;
+}
+
+// the list's pairs of charged atoms of the group, in its order: visit(i, j, now, then) with the
+// separation now and at the evaluation (from the displacements), then done_with(i) after the
+// pairs of each charged i
+template <typename Visit, typename DoneWith>
+void CoulFMMNearRefresh::for_each_charged_pair(Visit &&visit, DoneWith &&done_with) const
+{
+  double **x = atom->x;
   for (int ii = 0; ii < list->inum; ii++) {
     const int i = list->ilist[ii];
     if (!charged(i)) continue;
@@ -130,14 +126,34 @@ void CoulFMMNearRefresh::compute_all(const MTS &scheme, double trend, double **o
       double now[3], then[3];
       for (int k = 0; k < 3; k++) now[k] = x[i][k] - x[j][k];
       MTS::separation_then(now, delta[i], delta[j], then);
-      for (int k = 0; k < 3; k++) {
-        pair_now[k][p] = now[k];
-        pair_then[k][p] = then[k];
-      }
-      pair_j[p++] = j;
+      visit(i, j, now, then);
     }
-    pair_i.push_back({i, p});
+    done_with(i);
   }
+}
+
+// the pairs of charged atoms of the group in the list's order (their j and, per i, where
+// they end): their separations now and at the evaluation, then the kernel differences of all
+// of them in one call (SIMD), then the sums in the same order as pair by pair
+void CoulFMMNearRefresh::compute_all(const MTS &scheme, double trend, double **out)
+{
+  const int nlocal = atom->nlocal;
+  double *q = atom->q;
+  int npairs = 0;
+  for (int ii = 0; ii < list->inum; ii++)
+    if (charged(list->ilist[ii])) npairs += list->numneigh[list->ilist[ii]];
+  grow_pairs(npairs);
+  pair_i.clear();
+  int p = 0;
+  for_each_charged_pair(
+      [&](int, int j, const double *now, const double *then) {
+        for (int k = 0; k < 3; k++) {
+          pair_now[k][p] = now[k];
+          pair_then[k][p] = then[k];
+        }
+        pair_j[p++] = j;
+      },
+      [&](int i) { pair_i.push_back({i, p}); });
   gcfmm::charge_pair_change(p, {pair_now[0], pair_now[1], pair_now[2]},
                             {pair_then[0], pair_then[1], pair_then[2]},
                             {pair_dg[0], pair_dg[1], pair_dg[2], pair_dg[3], pair_r2now, pair_r2then},
@@ -189,37 +205,25 @@ bool CoulFMMNearRefresh::holds_current() const
 void CoulFMMNearRefresh::hold_pairs(const MTS &scheme, const CoulFMMState &state)
 {
   exchange_displacements(state);
-  double **x = atom->x, *q = atom->q;
-  int *mask = atom->mask;
-  const int groupbit = fix->groupbit;
-  auto charged = [&](int j) { return (mask[j] & groupbit) && q[j] != 0.0; };
   held.clear();
   held_i.clear();
-  for (int ii = 0; ii < list->inum; ii++) {
-    const int i = list->ilist[ii];
-    if (!charged(i)) continue;
-    for (int jj = 0; jj < list->numneigh[i]; jj++) {
-      const int j = list->firstneigh[i][jj] & NEIGHMASK;
-      if (!charged(j)) continue;
-      double now[3], then[3];
-      for (int k = 0; k < 3; k++) now[k] = x[i][k] - x[j][k];
-      MTS::separation_then(now, delta[i], delta[j], then);
-      const double r2then = then[0] * then[0] + then[1] * then[1] + then[2] * then[2];
-      if (r2then == 0.0) continue;
-      HeldPair h;
-      h.j = j;
-      h.r2then = r2then;
-      gcfmm::FieldTerms<double> t;
-      gcfmm::charge_terms<false>(1.0, then[0], then[1], then[2], 1.0 / std::sqrt(r2then), t);
-      h.terms_then[0] = t.ex;
-      h.terms_then[1] = t.ey;
-      h.terms_then[2] = t.ez;
-      h.terms_then[3] = t.pot;
-      scheme.slope_pair_change(now, delta[i], delta[j], h.slope_change);
-      held.push_back(h);
-    }
-    held_i.push_back({i, (int) held.size()});
-  }
+  for_each_charged_pair(
+      [&](int i, int j, const double *now, const double *then) {
+        const double r2then = then[0] * then[0] + then[1] * then[1] + then[2] * then[2];
+        if (r2then == 0.0) return;
+        HeldPair h;
+        h.j = j;
+        h.r2then = r2then;
+        gcfmm::FieldTerms<double> t;
+        gcfmm::charge_terms<false>(1.0, then[0], then[1], then[2], 1.0 / std::sqrt(r2then), t);
+        h.terms_then[0] = t.ex;
+        h.terms_then[1] = t.ey;
+        h.terms_then[2] = t.ez;
+        h.terms_then[3] = t.pot;
+        scheme.slope_pair_change(now, delta[i], delta[j], h.slope_change);
+        held.push_back(h);
+      },
+      [&](int i) { held_i.push_back({i, (int) held.size()}); });
   held_valid = true;
   held_ncalls = neighbor->ncalls;
   held_lastcall = neighbor->lastcall;

@@ -64,6 +64,9 @@ class CoulFMMNearRefresh : protected Pointers {
   gcsimd::SimdPath simd_path;
   void grow_pairs(int n);
   void exchange_displacements(const class CoulFMMState &state);
+  bool charged(int i) const;    // of the fix's group, with a charge
+  template <typename Visit, typename DoneWith>
+  void for_each_charged_pair(Visit &&visit, DoneWith &&done_with) const;
   void compute_all(const CoulFMMTimeStepping &scheme, double trend, double **out);
 
   // Between evaluations a pair's separation at the evaluation, now - (Delta_i - Delta_j), does
