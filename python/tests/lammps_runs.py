@@ -15,7 +15,7 @@ sys.path.insert(0, str(SRC / "python"))
 DECK = SRC / "python" / "granular_charged" / "decks" / "in.deposition"
 
 
-@pytest.fixture(scope="package")
+@pytest.fixture(scope="session")
 def build_dir():
     from granular_charged.run.lammps_build import BuildError, locate_build
     try:
