@@ -28,6 +28,7 @@
 #include "update.h"
 #include "utils.h"
 
+#include <cstddef>
 #include <cmath>
 #include <algorithm>
 #include <cstring>
@@ -68,6 +69,14 @@ struct StoredFixData : Modify {
 // the number of contacts (partners) a history holds for each local atom after a run
 struct HistoryPartners : FixNeighHistory {
   static int *FixNeighHistory::*count() { return &HistoryPartners::npartner; }
+};
+
+// a per-atom 3-vector array of Atom (memory->create: row i at [0] + 3 i) indexed without its row
+// pointers: one dependent load less for each atom a contact touches
+struct AtomRows {
+  double *first;
+  explicit AtomRows(double **rows) : first(rows ? rows[0] : nullptr) {}
+  double *operator[](int i) const { return first + 3 * static_cast<std::ptrdiff_t>(i); }
 };
 
 // the stored histories of pair styles granular and granular/opt no fix has taken
@@ -381,7 +390,7 @@ inline int PairGranularOpt::scales_of(int i, int j, const FusedMarshall &fm)
 void PairGranularOpt::gather_contacts()
 {
   int *type = atom->type;
-  double **x = atom->x;
+  const AtomRows x(atom->x);
   double *radius = atom->radius;
   double *special_lj = force->special_lj;
   const int size_hist = get_size_history();
@@ -528,8 +537,7 @@ void PairGranularOpt::compute_fused_contacts()
   auto lane_input = [&](int l) { return &lane_in[(l / W) * ML::N_INPUT * W + l % W]; };
   auto lane_output = [&](int l) { return &lane_out[(l / W) * ML::N_OUTPUT * W + l % W]; };
 
-  double **v = atom->v, **omega = atom->omega;
-  double **f = atom->f, **torque = atom->torque;
+  const AtomRows v(atom->v), omega(atom->omega), f(atom->f), torque(atom->torque);
   const double *radius = atom->radius, *rmass = atom->rmass;
   const int *mask = atom->mask;
   const int nlocal = atom->nlocal;
