@@ -408,22 +408,29 @@ void PairGranularOpt::gather_contacts()
     double *allhistory = use_history ? fix_history->firstvalue[i] : nullptr;
     const int *jlist = list->firstneigh[i];
     const int jnum = list->numneigh[i];
+    // i's data held in registers over its neighbors (the stores to touch flags, histories and
+    // contacts would otherwise make the compiler read them again for each)
+    const double xi[3] = {x[i][0], x[i][1], x[i][2]};
+    const double radi = radius[i];
+    const bool i_asleep = asleep && asleep[i] != 0.0;
+    const int *models_of_i = types_indices[type[i]];
+    const FusedMarshall *fused_models = fused.data();
     for (int jj = 0; jj < jnum; jj++) {
       const int j = jlist[jj] & NEIGHMASK;
       const double factor_lj = special_lj[sbmask(jlist[jj])];
       if (factor_lj == 0) continue;
-      if (asleep && asleep[i] != 0.0 && asleep[j] != 0.0) continue;
-      const int model = types_indices[type[i]][type[j]];
-      const FusedMarshall &fm = fused[model];
+      if (i_asleep && asleep[j] != 0.0) continue;
+      const int model = models_of_i[type[j]];
+      const FusedMarshall &fm = fused_models[model];
       if (!fm.on) {
         generic_i.push_back(i);
         generic_jj.push_back(jj);
         continue;
       }
       double dx[3];
-      sub3(x[i], x[j], dx);
+      sub3(xi, x[j], dx);
       const double rsq = lensq3(dx);
-      const double radsum = radius[i] + radius[j];
+      const double radsum = radi + radius[j];
       // most neighbors of a deposition do not touch: reject those before R_eff and the scales
       // (their history is zero already: zeroed when the contact ended, or new from the list)
       if (!touch[jj] && rsq >= radsum * radsum) continue;
