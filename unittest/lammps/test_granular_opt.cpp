@@ -4,7 +4,8 @@
    coefficients (both damping and both rolling conventions, with and without twisting), random
    spins (sliding, rolling and twisting slip), a JKR wall through fix wall/gran granular,
    contacts that form, load, unload and break beyond -delta_C, newton on and off, 1 and 2 ranks,
-   a type pair the fused kernel does not cover, and a restart in the middle of the contacts.
+   a type pair the fused kernel does not cover, atoms of one type with several radii, and a
+   restart in the middle of the contacts.
 
    Tolerance: the fused kernel performs the sub-models' floating-point operations in the same
    order (both call marshall_kernels.h), so the two styles agree to the last bit in practice;
