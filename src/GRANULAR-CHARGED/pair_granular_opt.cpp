@@ -28,6 +28,7 @@
 #include "update.h"
 #include "utils.h"
 
+#include <cstddef>
 #include <cmath>
 #include <algorithm>
 #include <cstring>
@@ -68,6 +69,14 @@ struct StoredFixData : Modify {
 // the number of contacts (partners) a history holds for each local atom after a run
 struct HistoryPartners : FixNeighHistory {
   static int *FixNeighHistory::*count() { return &HistoryPartners::npartner; }
+};
+
+// a per-atom 3-vector array of Atom (memory->create: row i at [0] + 3 i) indexed without its row
+// pointers: one dependent load less for each atom a contact touches
+struct AtomRows {
+  double *first;
+  explicit AtomRows(double **rows) : first(rows ? rows[0] : nullptr) {}
+  double *operator[](int i) const { return first + 3 * static_cast<std::ptrdiff_t>(i); }
 };
 
 // the stored histories of pair styles granular and granular/opt no fix has taken
@@ -357,18 +366,19 @@ void PairGranularOpt::type_scales()
 }
 
 /* ----------------------------------------------------------------------
-   R_eff and the JKR scales of pair i, j of a fused model (the type pair's if valid)
+   the entry of pair_scales with R_eff and the JKR scales of pair i, j of a fused model: its
+   type pair's if valid, else one appended for this pair (type_scales() drops those each step)
 ------------------------------------------------------------------------- */
 
-PairGranularOpt::PairScales PairGranularOpt::scales_of(int i, int j, const FusedMarshall &fm) const
+inline int PairGranularOpt::scales_of(int i, int j, const FusedMarshall &fm)
 {
   const int ntypes = atom->ntypes;
-  const PairScales &ps = pair_scales[atom->type[i] * (ntypes + 1) + atom->type[j]];
-  if (ps.valid) return ps;
-  PairScales mine;
+  const int type_pair = atom->type[i] * (ntypes + 1) + atom->type[j];
+  if (pair_scales[type_pair].valid) return type_pair;
+  PairScales &mine = pair_scales.emplace_back();
   mine.reff = MK::effective_radius(atom->radius[i], atom->radius[j]);
   mine.scales = MK::jkr_scales(mine.reff, fm.gamma, fm.emix);
-  return mine;
+  return static_cast<int>(pair_scales.size()) - 1;
 }
 
 /* ----------------------------------------------------------------------
@@ -380,7 +390,7 @@ PairGranularOpt::PairScales PairGranularOpt::scales_of(int i, int j, const Fused
 void PairGranularOpt::gather_contacts()
 {
   int *type = atom->type;
-  double **x = atom->x;
+  const AtomRows x(atom->x);
   double *radius = atom->radius;
   double *special_lj = force->special_lj;
   const int size_hist = get_size_history();
@@ -398,36 +408,52 @@ void PairGranularOpt::gather_contacts()
     double *allhistory = use_history ? fix_history->firstvalue[i] : nullptr;
     const int *jlist = list->firstneigh[i];
     const int jnum = list->numneigh[i];
+    // i's data held in registers over its neighbors (the stores to touch flags, histories and
+    // contacts would otherwise make the compiler read them again for each)
+    const double xi[3] = {x[i][0], x[i][1], x[i][2]};
+    const double radi = radius[i];
+    const bool i_asleep = asleep && asleep[i] != 0.0;
+    const int *models_of_i = types_indices[type[i]];
+    const FusedMarshall *fused_models = fused.data();
     for (int jj = 0; jj < jnum; jj++) {
       const int j = jlist[jj] & NEIGHMASK;
       const double factor_lj = special_lj[sbmask(jlist[jj])];
       if (factor_lj == 0) continue;
-      if (asleep && asleep[i] != 0.0 && asleep[j] != 0.0) continue;
-      const int model = types_indices[type[i]][type[j]];
-      const FusedMarshall &fm = fused[model];
+      if (i_asleep && asleep[j] != 0.0) continue;
+      const int model = models_of_i[type[j]];
+      const FusedMarshall &fm = fused_models[model];
       if (!fm.on) {
         generic_i.push_back(i);
         generic_jj.push_back(jj);
         continue;
       }
       double dx[3];
-      sub3(x[i], x[j], dx);
+      sub3(xi, x[j], dx);
       const double rsq = lensq3(dx);
-      const double radsum = radius[i] + radius[j];
+      const double radsum = radi + radius[j];
       // most neighbors of a deposition do not touch: reject those before R_eff and the scales
       // (their history is zero already: zeroed when the contact ended, or new from the list)
       if (!touch[jj] && rsq >= radsum * radsum) continue;
-      const PairScales ps = scales_of(i, j, fm);
-      if (!MK::jkr_touch(touch[jj] != 0, rsq, radsum, ps.scales.deltac)) {
+      const int scales = scales_of(i, j, fm);
+      const MK::JKRScales &sc = pair_scales[scales].scales;
+      if (!MK::jkr_touch(touch[jj] != 0, rsq, radsum, sc.deltac)) {
         touch[jj] = 0;
         double *history = &allhistory[size_hist * jj];
         for (int k = 0; k < size_hist; k++) history[k] = 0.0;
         continue;
       }
       touch[jj] = 1;
-      if (fm.gamma != 0.0)
-        jkr_overlap.push_back(MK::scaled_overlap(ps.scales, radsum - sqrt(rsq)));
-      contacts.push_back({i, jj, j, model, factor_lj, ps});
+      if (fm.gamma != 0.0) jkr_overlap.push_back(MK::scaled_overlap(sc, radsum - sqrt(rsq)));
+      // written field by field: a whole struct built on the stack and copied stalls the
+      // store-to-load forwarding of its parts
+      Contact &c = contacts.emplace_back();
+      c.i = i;
+      c.jj = jj;
+      c.j = j;
+      c.model = model;
+      c.scales = scales;
+      c.factor_lj = factor_lj;
+      copy3(dx, c.dx);
     }
   }
 }
@@ -518,9 +544,11 @@ void PairGranularOpt::compute_fused_contacts()
   auto lane_input = [&](int l) { return &lane_in[(l / W) * ML::N_INPUT * W + l % W]; };
   auto lane_output = [&](int l) { return &lane_out[(l / W) * ML::N_OUTPUT * W + l % W]; };
 
-  double **x = atom->x, **v = atom->v, **omega = atom->omega;
+  const AtomRows v(atom->v), omega(atom->omega), f(atom->f), torque(atom->torque);
   const double *radius = atom->radius, *rmass = atom->rmass;
   const int *mask = atom->mask;
+  const int nlocal = atom->nlocal;
+  const int newton_pair = force->newton_pair;
   const double *asleep = sleep.asleep;
   double **allhistory = fix_history->firstvalue;
   const int size_hist = get_size_history();
@@ -533,7 +561,7 @@ void PairGranularOpt::compute_fused_contacts()
     const double *history = &allhistory[i][size_hist * c.jj];
     auto put = [in, stride](int q, double value) { in[q * stride] = value; };
     for (int k = 0; k < 3; k++) {
-      put(ML::DX + k, x[i][k] - x[j][k]);
+      put(ML::DX + k, c.dx[k]);
       put(ML::VR + k, v[i][k] - v[j][k]);
       put(ML::OMEGA_I + k, omega[i][k]);
       put(ML::OMEGA_J + k, omega[j][k]);
@@ -554,14 +582,15 @@ void PairGranularOpt::compute_fused_contacts()
   };
   auto gather_shared = [&](const Contact &c, double *in, int stride) {
     const FusedMarshall &fm = fused[c.model];
-    const double reff = c.scales.reff;
+    const PairScales &ps = pair_scales[c.scales];
+    const double reff = ps.reff;
     auto put = [in, stride](int q, double value) { in[q * stride] = value; };
     put(ML::RAD_I, radius[c.i]);
     put(ML::RAD_J, radius[c.j]);
     put(ML::REFF, reff);
-    put(ML::ASEP, c.scales.scales.asep);
-    put(ML::FC, c.scales.scales.fc);
-    put(ML::SQRT_KN_SEP, c.scales.scales.sqrt_kn_sep);
+    put(ML::ASEP, ps.scales.asep);
+    put(ML::FC, ps.scales.fc);
+    put(ML::SQRT_KN_SEP, ps.scales.sqrt_kn_sep);
     put(ML::MASS_FACTOR, fm.mass_factor);
     put(ML::ALPHA, fm.alpha);
     put(ML::K_T, fm.k_t);
@@ -577,35 +606,67 @@ void PairGranularOpt::compute_fused_contacts()
     gather_own(c, s, in, stride);
     gather_shared(c, in, stride);
   };
-  // the results of one contact back: its histories (the sub-models it has), then forces and
-  // torques through scatter(); input and output q at in[q * stride], out[q * stride]
-  auto scatter_contact = [&](const Contact &c, const double *in, const double *out, int stride) {
+  // the force and torque on atom i summed in registers over its consecutive contacts (those of
+  // one entry of the neighbor list, none of which has i as its neighbor j): f[i] and torque[i]
+  // are read at the first and written after the last, the same additions in the same order
+  struct SumsOfI {
+    int i = -1;
+    double f[3], torque[3];
+  } sums;
+  auto store_sums = [&]() {
+    if (sums.i < 0) return;
+    copy3(sums.f, f[sums.i]);
+    copy3(sums.torque, torque[sums.i]);
+  };
+  // the results of one contact back: its histories (the sub-models it has), forces and torques
+  // times factor_lj to the atoms, the tallies, the sleepers' contact count and push; input and
+  // output q at in[q * stride], out[q * stride]
+  auto scatter_contact = [&](const Contact &c, const double *out, int stride) {
+    const int i = c.i, j = c.j;
     const FusedMarshall &fm = fused[c.model];
-    double *history = &allhistory[c.i][size_hist * c.jj];
-    PairForces pf;
+    double *history = &allhistory[i][size_hist * c.jj];
     for (int k = 0; k < 3; k++) {
       history[hist_tangential + k] = out[(ML::OUT_HIST_T + k) * stride];
       if (fm.rolling) history[hist_rolling + k] = out[(ML::OUT_HIST_R + k) * stride];
-      pf.forces[k] = out[(ML::FORCE + k) * stride];
-      pf.torquesi[k] = out[(ML::TORQUE_I + k) * stride];
-      pf.torquesj[k] = out[(ML::TORQUE_J + k) * stride];
-      pf.dx[k] = in[(ML::DX + k) * stride];
     }
     if (fm.twisting) history[hist_twisting] = out[ML::OUT_HIST_TW * stride];
-    scatter(c.i, c.j, c.factor_lj, pf);
+
+    if (i != sums.i) {
+      store_sums();
+      sums.i = i;
+      copy3(f[i], sums.f);
+      copy3(torque[i], sums.torque);
+    }
+    const double factor_lj = c.factor_lj;
+    double forces[3];
+    for (int k = 0; k < 3; k++) {
+      forces[k] = factor_lj * out[(ML::FORCE + k) * stride];
+      sums.f[k] = sums.f[k] + forces[k];
+      sums.torque[k] = sums.torque[k] + factor_lj * out[(ML::TORQUE_I + k) * stride];
+    }
+    const bool j_here = newton_pair || j < nlocal;
+    if (j_here)
+      for (int k = 0; k < 3; k++) {
+        f[j][k] = f[j][k] - forces[k];
+        torque[j][k] = torque[j][k] + factor_lj * out[(ML::TORQUE_J + k) * stride];
+      }
+    if (evflag)
+      ev_tally_xyz(i, j, nlocal, newton_pair, 0.0, 0.0, forces[0], forces[1], forces[2], c.dx[0],
+                   c.dx[1], c.dx[2]);
+    if (!asleep) return;
+    sleep.ncontact[i] += 1.0;
+    if (j_here) sleep.ncontact[j] += 1.0;
+    if (asleep[i] != 0.0) add3(sleep.push[i], forces, sleep.push[i]);
+    if (asleep[j] != 0.0 && j_here) sub3(sleep.push[j], forces, sleep.push[j]);
   };
 
   model_dt.resize(nmodels);
   for (int m = 0; m < nmodels; m++) model_dt[m] = models_list[m]->dt;
   // every contact of one model and one type pair whose atoms have one radius each (a
   // monodisperse packing of one type): the shared inputs are written into every lane once
-  const int *type = atom->type;
-  bool one_pair = n > 0;
-  for (std::size_t k = 0; k < n && one_pair; k++) {
-    const Contact &c = contacts[k];
-    one_pair = c.model == contacts[0].model && c.scales.valid &&
-        type[c.i] == type[contacts[0].i] && type[c.j] == type[contacts[0].j];
-  }
+  bool one_pair = n > 0 && pair_scales[contacts[0].scales].valid;
+  for (std::size_t k = 0; k < n && one_pair; k++)
+    one_pair = contacts[k].model == contacts[0].model && contacts[k].scales == contacts[0].scales;
   if (one_pair)
     for (int l = 0; l < static_cast<int>(CHUNK); l++) gather_shared(contacts[0], lane_input(l), W);
   std::size_t next_root = 0;
@@ -618,7 +679,6 @@ void PairGranularOpt::compute_fused_contacts()
       // gathering of the previous ones
       if (start + k + PREFETCH < n) {
         const int jn = contacts[start + k + PREFETCH].j;
-        __builtin_prefetch(x[jn]);
         __builtin_prefetch(v[jn]);
         __builtin_prefetch(omega[jn]);
       }
@@ -646,47 +706,20 @@ void PairGranularOpt::compute_fused_contacts()
       const Contact &c = contacts[start + k];
       if (k + PREFETCH < m) {
         const int jn = contacts[start + k + PREFETCH].j;
-        __builtin_prefetch(atom->f[jn], 1);
-        __builtin_prefetch(atom->torque[jn], 1);
+        __builtin_prefetch(f[jn], 1);
+        __builtin_prefetch(torque[jn], 1);
       }
       if (lane_of[k] >= 0) {
-        scatter_contact(c, lane_input(lane_of[k]), lane_output(lane_of[k]), W);
+        scatter_contact(c, lane_output(lane_of[k]), W);
       } else {
         double in[ML::N_INPUT], out[ML::N_OUTPUT];
         gather_contact(c, 1.0, in, 1);
         ML::marshall_contact(in, out, history_update);
-        scatter_contact(c, in, out, 1);
+        scatter_contact(c, out, 1);
       }
     }
   }
-}
-
-/* ----------------------------------------------------------------------
-   forces and torques to the atoms, the tallies, and the sleepers' contact count and push
-------------------------------------------------------------------------- */
-
-void PairGranularOpt::scatter(int i, int j, double factor_lj, PairForces &pf)
-{
-  double **f = atom->f, **torque = atom->torque;
-  const int nlocal = atom->nlocal;
-  const bool j_here = force->newton_pair || j < nlocal;
-  scale3(factor_lj, pf.forces);
-  add3(f[i], pf.forces, f[i]);
-  scale3(factor_lj, pf.torquesi);
-  add3(torque[i], pf.torquesi, torque[i]);
-  if (j_here) {
-    sub3(f[j], pf.forces, f[j]);
-    scale3(factor_lj, pf.torquesj);
-    add3(torque[j], pf.torquesj, torque[j]);
-  }
-  if (evflag)
-    ev_tally_xyz(i, j, nlocal, force->newton_pair, 0.0, 0.0, pf.forces[0], pf.forces[1],
-                 pf.forces[2], pf.dx[0], pf.dx[1], pf.dx[2]);
-  if (!sleep.asleep) return;
-  sleep.ncontact[i] += 1.0;
-  if (j_here) sleep.ncontact[j] += 1.0;
-  if (sleep.asleep[i] != 0.0) add3(sleep.push[i], pf.forces, sleep.push[i]);
-  if (sleep.asleep[j] != 0.0 && j_here) sub3(sleep.push[j], pf.forces, sleep.push[j]);
+  store_sums();
 }
 
 /* ----------------------------------------------------------------------

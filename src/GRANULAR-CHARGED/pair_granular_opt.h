@@ -84,13 +84,15 @@ class PairGranularOpt : public PairGranular {
     MarshallKernels::JKRScales scales;
   };
   std::vector<double> type_radius;       // radius of every atom of a type (-1: none)
-  std::vector<PairScales> pair_scales;   // per type pair (itype * (ntypes + 1) + jtype)
+  // per type pair (itype * (ntypes + 1) + jtype), then those of the fused contacts of this
+  // compute() whose type pair has none (atoms of one type with several radii)
+  std::vector<PairScales> pair_scales;
   // one fused contact of this compute(): atom, index in its neighbor list, the neighbor, its
-  // model, special factor and scales
+  // model, the entry of pair_scales, special factor and x_i - x_j
   struct Contact {
-    int i, jj, j, model;
+    int i, jj, j, model, scales;
     double factor_lj;
-    PairScales scales;
+    double dx[3];
   };
   std::vector<Contact> contacts;
   std::vector<double> jkr_overlap, jkr_root;    // the adhesive contacts' scaled overlaps, roots
@@ -99,9 +101,6 @@ class PairGranularOpt : public PairGranular {
   std::vector<double> lane_in, lane_out;
   std::vector<int> lane_of;
   std::vector<double> model_dt;          // time step of each model
-  struct PairForces {
-    double forces[3], torquesi[3], torquesj[3], dx[3];
-  };
   // the pairs outside the fused set (atom, index in its list) and their list for
   // PairGranular::compute, with copies of their contact flags and histories
   std::vector<int> generic_i, generic_jj;
@@ -124,8 +123,7 @@ class PairGranularOpt : public PairGranular {
   void gather_contacts();
   bigint compute_generic_pairs(int eflag, int vflag);
   void compute_fused_contacts();
-  void scatter(int i, int j, double factor_lj, PairForces &pf);
-  PairScales scales_of(int i, int j, const FusedMarshall &fm) const;
+  int scales_of(int i, int j, const FusedMarshall &fm);
 };
 
 }    // namespace LAMMPS_NS

@@ -4,7 +4,8 @@
    coefficients (both damping and both rolling conventions, with and without twisting), random
    spins (sliding, rolling and twisting slip), a JKR wall through fix wall/gran granular,
    contacts that form, load, unload and break beyond -delta_C, newton on and off, 1 and 2 ranks,
-   a type pair the fused kernel does not cover, and a restart in the middle of the contacts.
+   a type pair the fused kernel does not cover, atoms of one type with several radii, and a
+   restart in the middle of the contacts.
 
    Tolerance: the fused kernel performs the sub-models' floating-point operations in the same
    order (both call marshall_kernels.h), so the two styles agree to the last bit in practice;
@@ -175,6 +176,28 @@ TEST(PairGranularOpt, SameAsGranularNewtonOnOff)
     expect_same_forces(ref.forces, opt.forces);
     expect_same_state(ref.after, opt.after);
   }
+}
+
+// atoms of one type with several radii: no type pair has one R_eff, so each contact's R_eff and
+// JKR scales are its own (appended to the type pairs' table each step), checked step by step
+// against granular; newton off, so the ghost neighbors' forces are not summed here
+TEST(PairGranularOpt, RadiiDifferWithinAType)
+{
+  auto mixed_radii = [](const std::string &style) {
+    std::vector<std::string> cmds = cluster(style, "off");
+    auto sized = std::find(cmds.begin(), cmds.end(), "set type 2 diameter 2.012e-6");
+    cmds.insert(sized + 1, "set atom 1*9 diameter 1.994e-6");
+    return cmds;
+  };
+  std::vector<double> forces[2];
+  int k = 0;
+  for (const std::string style : {"granular", "granular/opt"}) {
+    Lmp l;
+    l.cmds(mixed_radii(style));
+    forces[k] = forces_per_step(l, 300, "radii" + std::to_string(k));
+    k++;
+  }
+  expect_same_forces(forces[0], forces[1]);
 }
 
 TEST(PairGranularOpt, TypePairOutsideTheFusedSet)
