@@ -770,10 +770,10 @@ TEST(CoulFMM, NearRefreshAndCheck)
 // evaluation, or over a list build, is off by the change of its field in between (~0.7 of the
 // force here). On two ranks the atom IDs, hence the charges, differ from one rank: there a
 // pair 1 A apart at the evaluation of step 32 flies apart at 0.5 A per step, beyond the near
-// cutoff + skin (8) by step 39. A list built then no longer holds it, and without an evaluation
-// brought forward (CoulFMMNearRefresh::pair_leaving) its field fell back to the one of step 32
-// (an error of 350 of the 350 kcal/mol/A on both atoms) on the step that depended on when the
-// lists were built: the two runs differed by 1.1e-4 at step 80.
+// cutoff + skin (8) by step 39. A list built then no longer holds it: without the evaluation
+// brought forward (CoulFMMNearRefresh::pair_leaving) its field would fall back to the one of
+// step 32 (an error of 350 kcal/mol/A, the whole pair force then, on both atoms) on a step that
+// depends on when the lists are built, and the two runs would differ by 1.1e-4 at step 80.
 TEST(CoulFMM, NearRefreshHeldPairsAsTakenEveryStep)
 {
   auto run = [](const std::string &check) {
@@ -790,7 +790,7 @@ TEST(CoulFMM, NearRefreshHeldPairsAsTakenEveryStep)
   const auto [each, each_evaluations] = run("no");
   std::printf("[ near held ] forces %.3g apart, %g and %g evaluations\n", rel_rms(held, each),
               held_evaluations, each_evaluations);
-  // measured 2.2e-13 on one rank, 4.3e-13 on two (7e-14 with the pairs taken every step in
+  // measured 2.1e-13 on one rank, 4.3e-13 on two (7e-14 with the pairs taken every step in
   // both runs): round-off of the refreshed differences, grown over 80 steps of fast atoms
   EXPECT_LT(rel_rms(held, each), 1e-11);
   EXPECT_EQ(held_evaluations, each_evaluations);
@@ -802,8 +802,8 @@ TEST(CoulFMM, NearRefreshHeldPairsAsTakenEveryStep)
 // there, brought forward from step 1000. At step 11 (3.2 A) the pair is beyond the list's
 // cutoff near + skin = 3 and beyond near at the evaluation and now, so its field is the one
 // of step 8, off from the fresh one by the closed form (r_11 / r_8)^2 - 1 = 0.51 (the field of
-// a point charge). Without the early evaluation the list built at step 11 no longer holds the
-// pair, and its field fell back to the one at 1 A: off by (3.2 / 1)^2 - 1 = 9.2.
+// a point charge). Without the early evaluation the list built at step 11 would no longer hold
+// the pair, and its field would fall back to the one at 1 A: off by (3.2 / 1)^2 - 1 = 9.2.
 TEST(CoulFMM, NearPairLeavingTheListsIsEvaluatedAfresh)
 {
   Lmp l;
