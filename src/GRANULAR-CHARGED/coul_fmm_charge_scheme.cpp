@@ -66,9 +66,11 @@ bool CoulFMMChargeScheme::continues()
 }
 
 // evaluate on the schedule's steps, whenever atoms were added or removed (fix deposit,
-// evaporate: a new atom must feel, and exert, the force from its first step) and whenever the
-// charges, qqrd2e or the geometry changed (a stored field would belong to other charges); a
-// line search evaluates several trial positions within one step: always (predict false)
+// evaporate: a new atom must feel, and exert, the force from its first step), whenever the
+// charges, qqrd2e or the geometry changed (a stored field would belong to other charges) and
+// when a pair refreshed since the evaluation is about to leave the neighbor lists
+// (CoulFMMNearRefresh::pair_leaving); a line search evaluates several trial positions within
+// one step: always (predict false)
 double CoulFMMChargeScheme::compute(bool predict)
 {
   if (!predict) {
@@ -77,13 +79,12 @@ double CoulFMMChargeScheme::compute(bool predict)
   }
   const bigint step = update->ntimestep;
   eval->update_sleepers();
-  const bool due = p.stepping->scheduled(step) ||
+  bool due = p.stepping->scheduled(step) ||
       p.state->continuity(*p.stepping, eval->boundary(), [this](int i) { return eval->asleep(i); }) !=
           MTS::Continuity::SAME;
-  if (due)
-    compute_field(true);
-  else if (p.stepping->settings().every > 1)
-    advance_field();
+  bool brought_forward = false;
+  if (!due && p.stepping->settings().every > 1 && !advance_field()) due = brought_forward = true;
+  if (due) compute_field(true, brought_forward);
   const int check = p.stepping->settings().check_every;
   if (check > 0 && !due && step % check == 0) eval->measure_error(*p.stepping, *p.state);
   return apply_field();
@@ -91,7 +92,7 @@ double CoulFMMChargeScheme::compute(bool predict)
 
 // a full evaluation (doc/theory.md, eqs. (5.2)-(5.4)); with the same atoms as at the last one
 // it first measures the error the time stepping had reached (CoulFMMTimeStepping::plan)
-void CoulFMMChargeScheme::compute_field(bool with_slope)
+void CoulFMMChargeScheme::compute_field(bool with_slope, bool brought_forward)
 {
   CoulFMMState &st = *p.state;
   st.check_charges(p.fix->id);
@@ -102,7 +103,8 @@ void CoulFMMChargeScheme::compute_field(bool with_slope)
   const auto cont = with_slope && mts.settings().every > 1
       ? st.continuity(mts, eval->boundary(), asleep_now)
       : MTS::Continuity::NONE;
-  const MTS::Plan plan = mts.plan(cont, with_slope, update->ntimestep);
+  MTS::Plan plan = mts.plan(cont, with_slope, update->ntimestep);
+  if (brought_forward) plan.ends_interval = false;
   // the refresh the time stepping would have applied now, and D for a new slope
   if (plan.near) {
     p.near->compute(mts, st, false, plan.keep_slope ? mts.trend_factor(plan.steps) : 0.0);
@@ -130,16 +132,21 @@ void CoulFMMChargeScheme::compute_field(bool with_slope)
   mts.finish_evaluation(plan, MTS::relative_rms(sums));
 }
 
-// eq. (5.2) between evaluations
-void CoulFMMChargeScheme::advance_field()
+// eq. (5.2) between evaluations; false (nothing advanced) if a near pair is leaving the lists
+// on some rank: then the field must be evaluated now
+bool CoulFMMChargeScheme::advance_field()
 {
   CoulFMMTimeStepping &mts = *p.stepping;
   const double steps = (double) (update->ntimestep - mts.evaluated.step);
   const bool refresh = mts.settings().near_cutoff > 0.0;
-  if (refresh) p.near->compute(mts, *p.state, false, mts.trend_factor(steps));
+  if (refresh) {
+    p.near->compute(mts, *p.state, false, mts.trend_factor(steps));
+    if (p.backend->communication().any(p.near->pair_leaving())) return false;
+  }
   for (int i = 0; i < atom->nlocal; i++)
     mts.predict(p.state->evaluation(i), steps, refresh ? p.near->now()[i] : nullptr,
                 p.state->field(i));
+  return true;
 }
 
 // F_i = q_i E_i into the state's forces; returns this rank's energy 1/2 sum q_i phi_i

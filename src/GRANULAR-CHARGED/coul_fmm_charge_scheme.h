@@ -42,8 +42,8 @@ class CoulFMMChargeScheme : public CoulFMMScheme, protected Pointers {
   Parts p;
   std::unique_ptr<CoulFMMEvaluator> eval;
   double nevaluations;
-  void compute_field(bool with_slope);
-  void advance_field();
+  void compute_field(bool with_slope, bool brought_forward = false);
+  bool advance_field();
   double apply_field();
 };
 

@@ -36,7 +36,7 @@ CoulFMMNearRefresh::CoulFMMNearRefresh(LAMMPS *lmp, Fix *owner) :
     Pointers(lmp), fix(owner), list(nullptr), delta(nullptr), near_now(nullptr), near_then(nullptr),
     nmax_delta(0), nmax_out(0), pair_now{}, pair_then{}, pair_dg{}, pair_r2now(nullptr),
     pair_r2then(nullptr), simd_path(gcsimd::default_simd_path()), held_valid(false),
-    held_ncalls(-1), held_lastcall(-1), held_box{}
+    leaving(false), held_ncalls(-1), held_lastcall(-1), held_box{}
 {
 }
 
@@ -72,6 +72,7 @@ void CoulFMMNearRefresh::compute(const MTS &scheme, const CoulFMMState &state, b
     memory->create(near_then, nmax_out, 4, "coul/fmm:near_then");
   }
   double **out = into_then ? near_then : near_now;
+  leaving = false;
   for (int i = 0; i < nlocal; i++)
     for (int k = 0; k < 4; k++) out[i][k] = 0.0;
   if (into_then) {
@@ -248,11 +249,14 @@ void CoulFMMNearRefresh::compute_held(const MTS &scheme, double trend, double **
   }
   gcfmm::charge_terms_at(held.size(), {pair_now[0], pair_now[1], pair_now[2]},
                          {pair_dg[0], pair_dg[1], pair_dg[2], pair_dg[3], pair_r2now}, simd_path);
+  const double cut = scheme.settings().near_cutoff, reach = cut + 0.5 * neighbor->skin;
+  const double cutsq = cut * cut, reachsq = reach * reach;
   p = 0;
   for (const auto &[i, end] : held_i) {
     double e[4] = {0.0, 0.0, 0.0, 0.0};
     for (; p < (std::size_t) end; p++) {
       const HeldPair &h = held[p];
+      if (h.r2then < cutsq && pair_r2now[p] >= reachsq) leaving = true;
       if (!scheme.near_pair_refreshed(pair_r2now[p], h.r2then, true)) continue;
       const int j = h.j;
       double dg[4];

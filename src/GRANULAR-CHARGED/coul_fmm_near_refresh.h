@@ -41,6 +41,13 @@ class CoulFMMNearRefresh : protected Pointers {
                double trend);
   // the evaluation state changed (an evaluation, a new run): the held pairs are taken afresh
   void forget_pairs() { held_valid = false; }
+  // after compute() between evaluations, on this rank: a pair closer than the near cutoff at
+  // the evaluation is now farther than the cutoff + skin/2. A list holds such a pair only while
+  // it is within the cutoff + skin when the list is built, so the field must be evaluated
+  // afresh now: a list built later would no longer refresh it, and its field would fall back
+  // to the one of the evaluation on a step that depends on when the lists are built. Found
+  // here, the pair is in every list whenever built (an atom moves less than skin/4 per step).
+  bool pair_leaving() const { return leaving; }
   double **now() const { return near_now; }
   double **then() const { return near_then; }
 
@@ -84,6 +91,7 @@ class CoulFMMNearRefresh : protected Pointers {
   // what the held pairs belong to: the neighbor build (count and step), the evaluation state
   // (forget_pairs) and the box (atoms unmap with it)
   bool held_valid;
+  bool leaving;
   bigint held_ncalls, held_lastcall;
   double held_box[9];
   void box_now(double box[9]) const;

@@ -95,6 +95,7 @@ CoulFMMTimeStepping::Plan CoulFMMTimeStepping::plan(Continuity continuity, bool 
   p.steps = p.same ? (double) (step - last) : 0.0;
   p.new_slope = p.same && set.extrapolate && step - last >= interval;
   p.near = p.same && set.near_cutoff > 0.0;
+  p.ends_interval = p.same;
   return p;
 }
 
@@ -155,7 +156,7 @@ void CoulFMMTimeStepping::end_evaluation(const Plan &p, double *st, const double
 void CoulFMMTimeStepping::finish_evaluation(const Plan &p, double error)
 {
   if (p.new_slope) slope_steps = p.steps;
-  if (p.same) adapt(error);
+  if (p.ends_interval) adapt(error);
 }
 
 /* ----------------------------------------------------------------------

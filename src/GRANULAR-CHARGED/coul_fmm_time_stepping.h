@@ -65,6 +65,9 @@ class CoulFMMTimeStepping {
     bool new_slope = false;   // a whole interval passed: take a new slope over it
     bool near = false;        // the near refresh is part of the prediction
     double steps = 0.0;       // steps since the last evaluation (same charges only)
+    // the measured error is that of the interval, which adapts to it: not of an evaluation
+    // brought forward (a near pair leaving the lists), whose shorter span would understate it
+    bool ends_interval = false;
   };
 
   // validates the settings; with a tolerance, every becomes the power of two at or below it

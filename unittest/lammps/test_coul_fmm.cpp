@@ -766,16 +766,16 @@ TEST(CoulFMM, NearRefreshAndCheck)
 // from the displacements every step: a run that builds the lists every step (so the pairs are
 // taken afresh every step) must give the same forces to round-off. every 32 with a slope
 // (trend > 0 after step 64), fast atoms (30000 K) and a skin of 3: 5 list builds of its own in
-// 80 steps, so held pairs outlive list builds between evaluations; the skin is wide enough that
-// no pair leaves the list while it is refreshed (the refreshed set then does not depend on when
-// lists are built, at every interval). A held pair kept over an evaluation, or over a list
-// build, is off by the change of its field in between (~0.7 of the force here).
+// 80 steps, so held pairs outlive list builds between evaluations. A held pair kept over an
+// evaluation, or over a list build, is off by the change of its field in between (~0.7 of the
+// force here). On two ranks the atom IDs, hence the charges, differ from one rank: there a
+// pair 1 A apart at the evaluation of step 32 flies apart at 0.5 A per step, beyond the near
+// cutoff + skin (8) by step 39. A list built then no longer holds it: without the evaluation
+// brought forward (CoulFMMNearRefresh::pair_leaving) its field would fall back to the one of
+// step 32 (an error of 350 kcal/mol/A, the whole pair force then, on both atoms) on a step that
+// depends on when the lists are built, and the two runs would differ by 1.1e-4 at step 80.
 TEST(CoulFMM, NearRefreshHeldPairsAsTakenEveryStep)
 {
-  // on two ranks these two runs differ by 1.1e-4 also with the pairs taken afresh every step
-  // (every 8 as well; 5e-14 at every 2): there the refreshed sum depends on when lists are
-  // built, which is not what this test is about
-  if (nprocs() != 1) GTEST_SKIP() << "one rank only";
   auto run = [](const std::string &check) {
     Lmp l;
     moving_charges(l, "p p f");
@@ -784,12 +784,55 @@ TEST(CoulFMM, NearRefreshHeldPairsAsTakenEveryStep)
             "atom_modify sort 1 4.0",
             "neigh_modify every 1 delay 0 check " + check,
             "fix fmm all coul/fmm accuracy 1e-8 every 32 near 5.0", "run 80 post no"});
-    return gather(l, "f", 3);
+    return std::make_pair(gather(l, "f", 3), l.var("f_fmm[10]"));
   };
-  const auto held = run("yes"), each = run("no");
-  std::printf("[ near held ] forces %.3g apart\n", rel_rms(held, each));
-  // measured 1.4e-13 (7e-14 with the pairs taken every step in both runs): round-off
+  const auto [held, held_evaluations] = run("yes");
+  const auto [each, each_evaluations] = run("no");
+  std::printf("[ near held ] forces %.3g apart, %g and %g evaluations\n", rel_rms(held, each),
+              held_evaluations, each_evaluations);
+  // measured 2.1e-13 on one rank, 4.3e-13 on two (7e-14 with the pairs taken every step in
+  // both runs): round-off of the refreshed differences, grown over 80 steps of fast atoms
   EXPECT_LT(rel_rms(held, each), 1e-11);
+  EXPECT_EQ(held_evaluations, each_evaluations);
+}
+
+// a pair closer than near at the evaluation stays refreshed until the next one, whenever the
+// lists are built: two like charges 1 A apart fly apart at 0.2 A per step (heavy), near 2,
+// skin 1, lists built every step. At step 8 they are 2.6 A apart, beyond near + skin/2 = 2.5: the field is evaluated
+// there, brought forward from step 1000. At step 11 (3.2 A) the pair is beyond the list's
+// cutoff near + skin = 3 and beyond near at the evaluation and now, so its field is the one
+// of step 8, off from the fresh one by the closed form (r_11 / r_8)^2 - 1 = 0.51 (the field of
+// a point charge). Without the early evaluation the list built at step 11 would no longer hold
+// the pair, and its field would fall back to the one at 1 A: off by (3.2 / 1)^2 - 1 = 9.2.
+TEST(CoulFMM, NearPairLeavingTheListsIsEvaluatedAfresh)
+{
+  Lmp l;
+  l.cmds({"units real", "atom_style charge", "atom_modify map array", "boundary m m m",
+          "region box block -10 10 -10 10 -10 10", "create_box 1 box",
+          "create_atoms 1 single -0.5 0.0 0.0", "create_atoms 1 single 0.5 0.0 0.0",
+          "mass 1 1.0e9", "set group all charge 1.0", "velocity all set 0.0 0.0 0.0",
+          "group left id 1", "group right id 2", "velocity left set -0.1 0.0 0.0 units box",
+          "velocity right set 0.1 0.0 0.0 units box", "fix nve all nve", "timestep 1.0",
+          "neighbor 1.0 bin", "neigh_modify every 1 delay 0 check no",
+          "fix fmm all coul/fmm accuracy 1e-10 order 30 every 1000 near 2.0", "run 8 post no"});
+  auto separation = [&l]() {
+    const auto x = gather(l, "x", 3);
+    return std::hypot(x[3] - x[0], x[4] - x[1], x[5] - x[2]);
+  };
+  const double r_evaluated = separation();
+  l.cmds({"run 3 post no"});
+  const double r_now = separation(), evaluations = l.var("f_fmm[10]");
+  const auto f = gather(l, "f", 3);
+  l.cmds({"unfix fmm", "fix fresh all coul/fmm accuracy 1e-10 order 30", "run 0 post no"});
+  const double error = std::fabs(f[0] / gather(l, "f", 3)[0] - 1.0);
+  const double frozen = std::pow(r_now / r_evaluated, 2) - 1.0;
+  std::printf("[ near leaving ] separations %.4g at step 8 and %.4g at step 11, %g evaluations; "
+              "force off by %.6g (frozen since step 8: %.6g, %.2g apart)\n",
+              r_evaluated, r_now, evaluations, error, frozen, std::fabs(error - frozen));
+  EXPECT_EQ(evaluations, 2.0);
+  // the closed form takes the separations the atoms had (their repulsion included); measured
+  // to round-off, 1e-9 leaves room for the solver's accuracy (1e-10)
+  EXPECT_NEAR(error, frozen, 1e-9);
 }
 
 // extrapolation of the far part: on nearly straight trajectories (heavy charges) the far part
