@@ -24,6 +24,7 @@ def test_finds_diary(tmp_path):
     assert hits("as of Dec 2026 the order is 9\n", tmp_path) == ["date"]
     assert hits("on 3 December 2026 we\n", tmp_path) == ["date"]
     assert hits("in the fifth session, the\n", tmp_path) == ["word"]
+    assert hits('@pytest.fixture(scope="session")\n', tmp_path) == ["word"]
     assert hits("a later sitting gave\n", tmp_path) == ["word"]
     assert hits("yesterday's run\n", tmp_path) == ["word"]
     assert hits("fixed in issue 45\n", tmp_path) == ["issue"]
@@ -34,7 +35,6 @@ def test_finds_diary(tmp_path):
 def test_lets_pass(tmp_path):
     assert hits("LAMMPS 4Jul2026 and 4Feb2025 (20260704)\n", tmp_path) == []
     assert hits("Chen et al., Soft Matter 2016\n", tmp_path) == []
-    assert hits('@pytest.fixture(scope="session")\n', tmp_path) == []
     assert hits("the order is 9 and the leaf size 80\n", tmp_path) == []
 
 

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Coulomb benchmark in the deposition geometry (issue 4): fix coul/fmm vs LAMMPS's pppm + slab,
+"""Coulomb benchmark in the deposition geometry: fix coul/fmm vs LAMMPS's pppm + slab,
 ewald + slab and direct coul/cut, time per force evaluation and relative RMS force error vs a
 reference, all measured in one run of this script.
 

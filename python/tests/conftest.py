@@ -12,7 +12,7 @@ import pytest
 from lammps_runs import SRC, build_dir  # noqa: F401 (build_dir: the fixture, shared)
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="package")
 def cli(build_dir):
     """Run `python -m granular_charged ARGS` (the command line) in a folder; returns the
     CompletedProcess. The package comes from this checkout, LAMMPS from build_dir."""

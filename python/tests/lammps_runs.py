@@ -15,7 +15,7 @@ sys.path.insert(0, str(SRC / "python"))
 DECK = SRC / "python" / "granular_charged" / "decks" / "in.deposition"
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="package")
 def build_dir():
     from granular_charged.run.lammps_build import BuildError, locate_build
     try:

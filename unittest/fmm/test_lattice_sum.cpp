@@ -719,7 +719,7 @@ TEST(PeriodicFarField, DISABLED_AspectScan) {
   }
 }
 
-// issue 28, item 5: the set-up's cost grows linearly with the column height (H/L = 300 took
+// the set-up's cost grows linearly with the column height (H/L = 300 took
 // 16 s and 1.7 GB, 1e4 was killed by the out-of-memory killer, 1e5 threw std::bad_alloc): a
 // column beyond kMaxSetupBytes is refused before anything is allocated, quickly, with the
 // cost in the message, and the object stays as it was. The estimate itself is checked against
@@ -751,7 +751,7 @@ TEST(PeriodicFarField, TallColumnRefusedBeforeAllocating) {
 
 // Rectangular cells up to the supported aspect ratio 2 and tall columns (H / L = 50) meet the
 // requested accuracy against the independent 2D Ewald sum; beyond aspect 2 setup() refuses
-// with a std::invalid_argument naming the range (issue 11 f: 1:4 gave 4.5e-4 at 1e-4).
+// with a std::invalid_argument naming the range (1:4 gave 4.5e-4 at 1e-4).
 TEST(PeriodicFarField, AspectRatioAndTallColumns) {
   {
     const Config c = column(400, 28, 14, 10, 60, 13);

@@ -246,7 +246,7 @@ TEST(CoulFMM, BadInput)
   expect_match(run_with("charge", "p p f", "fix fmm all coul/fmm tolerance 1e-4"), "tolerance 0.0001 needs every > 1");
 }
 
-// issue 28, item 7: settings that were accepted without a word or refused with a message that
+// settings that were accepted without a word or refused with a message that
 // did not fit. Warnings are read from the screen output of rank 0.
 TEST(CoulFMM, CoulombPairStyleFreeSpaceKeywordsNearCutoff)
 {
@@ -393,7 +393,7 @@ TEST(CoulFMM, EveryWithDeposit)
   std::remove("coul_fmm_particle.mol");
 }
 
-// ---- issue 28, item 1: the stored field must be re-evaluated whenever it no longer belongs to
+// ---- the stored field must be re-evaluated whenever it no longer belongs to
 // the charges (values, atom IDs), qqrd2e or the boundary. Each case compares the fix's energy
 // and forces with a fresh evaluation at the same positions and charges: the same tree, so the
 // two agree to round-off (1e-10 allows for the order of the MPI sums); a stale field is off
@@ -498,7 +498,7 @@ TEST(CoulFMM, StaleFieldBoundaryChanged)
   expect_as_fresh(l, "change_box", 100);
 }
 
-// issue 28, item 5: 100 charges in a 10 A cell and one charge 1e6 A above them (H/L = 1e5):
+// 100 charges in a 10 A cell and one charge 1e6 A above them (H/L = 1e5):
 // the exact far field would need ~1e5 boxes (before: std::bad_alloc; H/L = 1e4 was killed by
 // the out-of-memory killer): a clear error before anything is allocated, naming the cost and
 // what to do; farfield average is not limited

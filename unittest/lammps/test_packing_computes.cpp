@@ -451,7 +451,7 @@ TEST(PackingComputes, PeriodicZ)
   }
 }
 
-// issue 28, item 4: slab bounds far outside a box periodic in z. The remainder beyond whole
+// slab bounds far outside a box periodic in z. The remainder beyond whole
 // periods comes from the bounds wrapped into the box, and phi from the share of whole periods
 // (not their count): a slab of +-1e300 in a box 1e-9 thick (2e309 periods, which overflowed to
 // inf before) gives the same phi as +-1e10; bounds whose distance is not a finite number are
