@@ -28,6 +28,8 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <filesystem>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -263,22 +265,30 @@ TEST(MarshallLanes, ContactsCoverEveryBranch)
 std::string run_bed(const std::string &simd, const std::string &tag)
 {
   const std::string dir = std::string(GC_SOURCE_DIR);
-  const std::string dump = "lanes_bed_" + tag + ".dump";
+  // the dumps go to a folder of their own, never into the working directory
+  std::string scratch_template =
+      (std::filesystem::temp_directory_path() / "gc_lanes_bed_XXXXXX").string();
+  if (!mkdtemp(scratch_template.data())) return "";
+  const std::string scratch = scratch_template;
+  const std::string input = scratch + "/bed.dump";
+  const std::string dump = scratch + "/forces_" + tag + ".dump";
   const std::string bed = dir + "/doc/data/paper-size/runs/rp2um_U1_g10mJ_q0_N2000_s1";
-  if (std::system(("zcat " + bed + "/final.dump.gz > lanes_bed.dump").c_str()) != 0) return "";
-  std::ifstream f("lanes_bed.dump");
+  if (std::system(("zcat " + bed + "/final.dump.gz > " + input).c_str()) != 0) return "";
+  std::ifstream f(input);
   std::string line, step;
   std::getline(f, line);
   std::getline(f, step);
   const std::string cmd = (simd.empty() ? std::string("env -u GCFMM_SIMD ")
                                         : "env GCFMM_SIMD=" + simd + " ") +
       GC_LMP_EXECUTABLE + " -log none -echo none -screen none -nocite -in " + dir +
-      "/bench/kernels/in.bed -var dump lanes_bed.dump -var step " + step +
+      "/bench/kernels/in.bed -var dump " + input + " -var step " + step +
       " -var steps 200 -var pair granular/opt -var forces " + dump;
   if (std::system(cmd.c_str()) != 0) return "";
   std::ifstream d(dump);
   std::stringstream all;
   all << d.rdbuf();
+  d.close();
+  std::filesystem::remove_all(scratch);
   return all.str();
 }
 
@@ -288,7 +298,7 @@ TEST(MarshallLanes, GenericPathSameRunAsDefault)
   const std::string best = run_bed("", "default");
   ASSERT_FALSE(generic.empty()) << "the bed run with GCFMM_SIMD=generic failed";
   ASSERT_FALSE(best.empty()) << "the bed run on the default path failed";
-  EXPECT_TRUE(generic == best) << "dumps differ: lanes_bed_generic.dump, lanes_bed_default.dump";
+  EXPECT_TRUE(generic == best) << "the generic and the default path wrote different dumps";
 }
 #endif
 
