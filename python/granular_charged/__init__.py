@@ -3,7 +3,7 @@ sweep parameters, analyse packings and draw the figures of Chen, Li, Liu & Makse
 2016).
 
 Command line: ``granular-charged`` (or ``python3 -m granular_charged``), see doc/python.md.
-Subpackages, each layer importing only those below it:
+Subpackages:
 
 - ``cli``: the command line's subcommands (only ``__main__`` imports it);
 - ``studies``: many runs (sweeps, study files, demo, reproduce) and the Snakemake engine;
