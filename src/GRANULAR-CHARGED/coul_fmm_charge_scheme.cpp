@@ -68,8 +68,8 @@ bool CoulFMMChargeScheme::continues()
 // evaluate on the schedule's steps, whenever atoms were added or removed (fix deposit,
 // evaporate: a new atom must feel, and exert, the force from its first step), whenever the
 // charges, qqrd2e or the geometry changed (a stored field would belong to other charges) and
-// when a pair refreshed since the evaluation is about to leave the neighbor lists
-// (CoulFMMNearRefresh::pair_leaving); a line search evaluates several trial positions within
+// when a pair refreshed since the evaluation is about to leave the neighbor lists or has left
+// them (CoulFMMNearRefresh::pair_leaving); a line search evaluates several trial positions within
 // one step: always (predict false)
 double CoulFMMChargeScheme::compute(bool predict)
 {
@@ -122,6 +122,7 @@ void CoulFMMChargeScheme::compute_field(bool with_slope, bool brought_forward)
   st.record(mts, eval->boundary());
   p.near->forget_pairs();    // the held pairs belong to the evaluation state overwritten above
   eval->evaluate([&st](int i) { return st.evaluated_field(i); }, true);
+  if (mts.refreshes_near()) p.near->record_evaluation(mts.settings().near_cutoff);
   nevaluations += 1.0;
   double sums[2] = {0.0, 0.0};
   for (int i = 0; i < nlocal; i++) {

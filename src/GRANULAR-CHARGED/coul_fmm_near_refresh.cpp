@@ -32,11 +32,20 @@
 using namespace LAMMPS_NS;
 using MTS = CoulFMMTimeStepping;
 
+namespace {
+// a pair of the half list without newton counts once over all ranks: a ghost j is a local atom
+// elsewhere (or an image here) whose own list holds the pair the other way round
+double near_pair_weight(int j, int nlocal)
+{
+  return j < nlocal ? 1.0 : 0.5;
+}
+}    // namespace
+
 CoulFMMNearRefresh::CoulFMMNearRefresh(LAMMPS *lmp, Fix *owner) :
     Pointers(lmp), fix(owner), list(nullptr), delta(nullptr), near_now(nullptr), near_then(nullptr),
     nmax_delta(0), nmax_out(0), pair_now{}, pair_then{}, pair_dg{}, pair_r2now(nullptr),
     pair_r2then(nullptr), simd_path(gcsimd::default_simd_path()), held_valid(false),
-    leaving(false), held_ncalls(-1), held_lastcall(-1), held_box{}
+    leaving(false), near_pairs_evaluated(-1.0), pairs_lost(false), held_ncalls(-1), held_lastcall(-1), held_box{}
 {
 }
 
@@ -82,6 +91,7 @@ void CoulFMMNearRefresh::compute(const MTS &scheme, const CoulFMMState &state, b
     // every rank decides alike: neighbor builds, evaluations and the box are global
     if (!holds_current()) hold_pairs(scheme, state);
     compute_held(scheme, trend, out);
+    leaving = leaving || pairs_lost;
   }
   const double c = force->qqrd2e;
   for (int i = 0; i < nlocal; i++)
@@ -183,6 +193,26 @@ void CoulFMMNearRefresh::compute_all(const MTS &scheme, double trend, double **o
   }
 }
 
+void CoulFMMNearRefresh::record_evaluation(double near_cutoff)
+{
+  const double cutsq = near_cutoff * near_cutoff;
+  double **x = atom->x;
+  double mine = 0.0;
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    if (!charged(i)) continue;
+    for (int jj = 0; jj < list->numneigh[i]; jj++) {
+      const int j = list->firstneigh[i][jj] & NEIGHMASK;
+      if (!charged(j)) continue;
+      const double dx = x[i][0] - x[j][0], dy = x[i][1] - x[j][1], dz = x[i][2] - x[j][2];
+      const double r2 = dx * dx + dy * dy + dz * dz;
+      if (r2 < cutsq && r2 != 0.0) mine += near_pair_weight(j, atom->nlocal);
+    }
+  }
+  MPI_Allreduce(&mine, &near_pairs_evaluated, 1, MPI_DOUBLE, MPI_SUM, world);
+  pairs_lost = false;
+}
+
 void CoulFMMNearRefresh::box_now(double box[9]) const
 {
   const double now[9] = {domain->boxlo[0], domain->boxlo[1], domain->boxlo[2],
@@ -208,10 +238,13 @@ void CoulFMMNearRefresh::hold_pairs(const MTS &scheme, const CoulFMMState &state
   exchange_displacements(state);
   held.clear();
   held_i.clear();
+  const double cut = scheme.settings().near_cutoff, cutsq = cut * cut;
+  double near_mine = 0.0;
   for_each_charged_pair(
       [&](int i, int j, const double *now, const double *then) {
         const double r2then = then[0] * then[0] + then[1] * then[1] + then[2] * then[2];
         if (r2then == 0.0) return;
+        if (r2then < cutsq) near_mine += near_pair_weight(j, atom->nlocal);
         HeldPair h;
         h.j = j;
         h.r2then = r2then;
@@ -225,6 +258,13 @@ void CoulFMMNearRefresh::hold_pairs(const MTS &scheme, const CoulFMMState &state
         held.push_back(h);
       },
       [&](int i) { held_i.push_back({i, (int) held.size()}); });
+  // every pair closer than the cutoff at the evaluation must still be in the list
+  double near_held = 0.0;
+  MPI_Allreduce(&near_mine, &near_held, 1, MPI_DOUBLE, MPI_SUM, world);
+  if (near_pairs_evaluated < 0.0)
+    near_pairs_evaluated = near_held;
+  else if (near_held < near_pairs_evaluated)
+    pairs_lost = true;
   held_valid = true;
   held_ncalls = neighbor->ncalls;
   held_lastcall = neighbor->lastcall;

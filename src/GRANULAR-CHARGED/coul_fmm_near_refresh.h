@@ -48,6 +48,12 @@ class CoulFMMNearRefresh : protected Pointers {
   // to the one of the evaluation on a step that depends on when the lists are built. Found
   // here, the pair is in every list whenever built (an atom moves less than skin/4 per step).
   bool pair_leaving() const { return leaving; }
+  // at an evaluation: the number of charged pairs closer than the near cutoff (the pairs the
+  // refresh must hold until the next evaluation). A list built later that holds fewer of them
+  // (an atom moved more than skin/4 in a step, so a pair passed near + skin/2 and the list's
+  // cutoff between two steps) sets pair_leaving(): the field is evaluated afresh, whatever the
+  // atoms' speed.
+  void record_evaluation(double near_cutoff);
   double **now() const { return near_now; }
   double **then() const { return near_then; }
 
@@ -92,6 +98,10 @@ class CoulFMMNearRefresh : protected Pointers {
   // (forget_pairs) and the box (atoms unmap with it)
   bool held_valid;
   bool leaving;
+  // pairs closer than the cutoff at the evaluation, over all ranks (a pair whose second atom
+  // is a ghost counts 1/2 on each rank that holds it); -1 while unknown (after a restart)
+  double near_pairs_evaluated;
+  bool pairs_lost;
   bigint held_ncalls, held_lastcall;
   double held_box[9];
   void box_now(double box[9]) const;

@@ -12,6 +12,7 @@
 #include "citeme.h"
 #include "comm.h"
 #include "error.h"
+#include "fix_charge_check.h"
 #include "gran_sub_mod.h"
 #include "granular_model.h"
 #include "math_const.h"
@@ -110,6 +111,10 @@ void GranSubModNormalJKRMarshall::mix_coeffs(double *icoeffs, double *jcoeffs)
 
 void GranSubModNormalJKRMarshall::init()
 {
+  // charges without a Coulomb solver are said at the start of a run (not from inside fix
+  // wall/gran's constructor, which calls init() too: a fix cannot be added there)
+  if (gm->contact_type == PAIR) FixChargeCheck::ensure(lmp);
+
   // by name (damping marshall and marshall/printed), so that the normal model does not depend
   // on the damping model's class
   if (!utils::strmatch(gm->sub_models[DAMPING]->name, "^marshall"))

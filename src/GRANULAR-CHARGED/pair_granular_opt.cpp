@@ -15,6 +15,7 @@
 #include "comm.h"
 #include "error.h"
 #include "fix.h"
+#include "fix_charge_check.h"
 #include "fix_neigh_history.h"
 #include "force.h"
 #include "gran_sub_mod.h"
@@ -183,26 +184,6 @@ void PairGranularOpt::warn_fresh_history()
 
 /* ---------------------------------------------------------------------- */
 
-// atoms carry charges but nothing computes their Coulomb interactions (no fix coul/fmm, no
-// kspace, no pair style with a coul part, no fix efield): true if it said so
-static bool warn_unused_charges(LAMMPS *lmp)
-{
-  Atom *atom = lmp->atom;
-  if (!atom->q_flag || lmp->force->kspace || lmp->force->pair_match("coul", 0)) return false;
-  if (!lmp->modify->get_fix_by_style("^coul/fmm").empty() ||
-      !lmp->modify->get_fix_by_style("^efield").empty())
-    return false;
-  int charged = 0, any = 0;
-  for (int i = 0; i < atom->nlocal && !charged; i++) charged = atom->q[i] != 0.0;
-  MPI_Allreduce(&charged, &any, 1, MPI_INT, MPI_MAX, lmp->world);
-  if (!any) return false;
-  if (lmp->comm->me == 0)
-    lmp->error->warning(FLERR, "Atoms carry charges, but no Coulomb interaction is computed (no "
-                               "fix coul/fmm, kspace or pair style with coul): define fix "
-                               "coul/fmm to include them");
-  return true;
-}
-
 void PairGranularOpt::init_style()
 {
   const bool first_init = fix_history == nullptr;
@@ -217,7 +198,7 @@ void PairGranularOpt::init_style()
   sleep_fix = sleepers.empty() ? nullptr : sleepers.front();
   if (sleepers.size() > 1) error->all(FLERR, "Only one fix sleep/gran may be defined");
   active_build = active_generation = -1;
-  if (!charges_warned) charges_warned = warn_unused_charges(lmp);
+  FixChargeCheck::ensure(lmp);    // charges without a Coulomb solver: warned at init
 }
 
 /* ---------------------------------------------------------------------- */

@@ -73,7 +73,6 @@ class PairGranularOpt : public PairGranular {
   std::vector<int> active;
   bigint active_build, active_generation;
   bigint ncontacts;
-  bool charges_warned = false;           // warn_unused_charges() said it
   bool history_update;                   // this compute() advances the contact histories
   int hist_tangential, hist_rolling, hist_twisting;    // offsets in the per-pair history
 

@@ -835,6 +835,48 @@ TEST(CoulFMM, NearPairLeavingTheListsIsEvaluatedAfresh)
   EXPECT_NEAR(error, frozen, 1e-9);
 }
 
+// a pair closer than near at the evaluation that passes the list's cutoff (near + skin) between
+// two steps, faster than the refresh's margin (skin/4 per step per atom): two like charges 1 A
+// apart at the evaluation of step 0 fly apart at `speed` A per step each. The list built when
+// they have passed near + skin no longer holds them; the field is evaluated afresh then (two
+// evaluations), and the force equals LAMMPS's direct coul/cut at the same positions. Without
+// it the pair's field would stay that of the evaluation at 1 A: off by (r / 1 A)^2 - 1,
+// ~11x for the jump of 1.25 A (skin 0.4) and ~9x for 0.09 A per step with a skin of 0.01.
+TEST(CoulFMM, NearPairJumpingOutOfTheListsIsEvaluatedAfresh)
+{
+  struct Case {
+    double skin, speed;
+    int steps;
+  };
+  for (const Case c : {Case{0.4, 1.25, 1}, Case{0.01, 0.09, 12}}) {
+    Lmp l;
+    l.cmds({"units real", "atom_style charge", "atom_modify map array", "boundary f f f",
+            "region box block -10 10 -10 10 -10 10", "create_box 1 box",
+            "create_atoms 1 single -0.5 0.0 0.0", "create_atoms 1 single 0.5 0.0 0.0",
+            "mass 1 1.0e12", "set group all charge 1.0", "velocity all set 0.0 0.0 0.0",
+            "group left id 1", "group right id 2",
+            fmt::format("velocity left set {} 0.0 0.0 units box", -c.speed),
+            fmt::format("velocity right set {} 0.0 0.0 units box", c.speed), "fix nve all nve",
+            "timestep 1.0", fmt::format("neighbor {} bin", c.skin),
+            "neigh_modify every 1 delay 0 check yes",
+            "fix fmm all coul/fmm accuracy 1e-10 order 30 every 64 near 3.0",
+            fmt::format("run {} post no", c.steps)});
+    const auto f = gather(l, "f", 3);
+    const double evaluations = l.var("f_fmm[10]");
+    l.cmds({"unfix fmm", "pair_style coul/cut 50.0", "pair_coeff * *", "run 0 post no"});
+    const auto reference = gather(l, "f", 3);
+    const auto x = gather(l, "x", 3);
+    const double r = x[3] - x[0];
+    std::printf("[ near jump ] skin %g, %g A per step: %.4g A apart after %d steps, %g "
+                "evaluations, force off by %.3g\n",
+                c.skin, c.speed, r, c.steps, evaluations, rel_rms(f, reference));
+    EXPECT_GT(r, 3.0 + c.skin);
+    EXPECT_EQ(evaluations, 2.0);
+    // a fresh evaluation at 1e-10 of two charges against the direct sum: the solver's accuracy
+    EXPECT_LT(rel_rms(f, reference), 1e-6);
+  }
+}
+
 // extrapolation of the far part: on nearly straight trajectories (heavy charges) the far part
 // of the field changes nearly linearly between evaluations, so the slope of the last two
 // evaluations removes most of the error of a frozen field; the close pairs, whose field is not

@@ -10,12 +10,13 @@
      ratio of the widths) warns once, however often it is invoked; a slab inside the box does
      not warn.
    - ChargesWithoutCoulombSolver: atoms with charges but no fix coul/fmm, kspace or coul pair
-     style under pair_style granular/opt warn once over two runs; neutral atoms, or the same
-     charges with fix coul/fmm, do not.
+     style under pair_style granular and granular/opt with jkr/marshall warn once over two runs;
+     neutral atoms, or the same charges with fix coul/fmm, do not.
 
    Checked against broken code: without the warning in jkr/marshall's init() the first test
    finds no warning; without the check in compute_array() the second finds none; without
-   warn_unused_charges() in PairGranularOpt::init_style() the third finds none. */
+   FixChargeCheck::ensure() in jkr/marshall's init() the third finds none under pair_style
+   granular, without the check in FixChargeCheck::init() none under either style. */
 #include "gc_testing.h"
 
 #include "gtest/gtest.h"
@@ -126,23 +127,28 @@ TEST(SilentMistakes, RdfSlabOutsideTheBox)
 
 TEST(SilentMistakes, ChargesWithoutCoulombSolver)
 {
-  auto deck = [](const std::string &charge, const std::string &solver) {
-    auto c = spheres();
-    c[1] = "atom_style hybrid sphere charge";
-    c.insert(c.end(), {"pair_coeff * * " + model("marshall/jkr"), "set group all charge " + charge});
-    if (!solver.empty()) c.push_back(solver);
-    c.push_back("run 10");
-    c.push_back("run 10");
-    return c;
-  };
-  const std::string warning = "Atoms carry charges, but no Coulomb interaction is computed";
-  const std::string charged = log_of(deck("1e-16", ""));
-  const std::string neutral = log_of(deck("0.0", ""));
-  const std::string solved =
-      log_of(deck("1e-16", "fix fmm all coul/fmm accuracy 1e-4 farfield none"));
-  if (rank() != 0) return;
-  EXPECT_EQ(occurrences(charged, warning), 1) << charged;
-  EXPECT_EQ(occurrences(charged, "define fix coul/fmm"), 1);
-  EXPECT_EQ(occurrences(neutral, warning), 0) << neutral;
-  EXPECT_EQ(occurrences(solved, warning), 0) << solved;
+  for (const std::string style : {"granular", "granular/opt"}) {
+    auto deck = [&style](const std::string &charge, const std::string &solver) {
+      auto c = spheres();
+      c[1] = "atom_style hybrid sphere charge";
+      for (auto &line : c)
+        if (line == "pair_style granular/opt") line = "pair_style " + style;
+      c.insert(c.end(),
+               {"pair_coeff * * " + model("marshall/jkr"), "set group all charge " + charge});
+      if (!solver.empty()) c.push_back(solver);
+      c.push_back("run 10");
+      c.push_back("run 10");
+      return c;
+    };
+    const std::string warning = "Atoms carry charges, but no Coulomb interaction is computed";
+    const std::string charged = log_of(deck("1e-16", ""));
+    const std::string neutral = log_of(deck("0.0", ""));
+    const std::string solved =
+        log_of(deck("1e-16", "fix fmm all coul/fmm accuracy 1e-4 farfield none"));
+    if (rank() != 0) continue;
+    EXPECT_EQ(occurrences(charged, warning), 1) << style << "\n" << charged;
+    EXPECT_EQ(occurrences(charged, "define fix coul/fmm"), 1);
+    EXPECT_EQ(occurrences(neutral, warning), 0) << style << "\n" << neutral;
+    EXPECT_EQ(occurrences(solved, warning), 0) << style << "\n" << solved;
+  }
 }
