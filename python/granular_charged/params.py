@@ -146,8 +146,8 @@ class DepositionParams:
     def key(self) -> str:
         """The name of the run's folder: the series (r_p, U_0, gamma), q, N and the seed, then
         ``_h`` and a hash of every non-default value (:meth:`non_default`) when anything else
-        differs from its default or one of those values is not written out exactly: at most
-        ~80 characters, the same for the same run however its values are written (``E 2e8`` is
+        differs from its default or one of those values is not written out exactly: about
+        40-60 characters (at most ~100), the same for the same run however its values are written (``E 2e8`` is
         ``E 200000000``, a value at its default is the default), different for different runs.
         The run's params.json and result.json list every value."""
         canon = self.non_default()
