@@ -270,6 +270,17 @@ def test_a_lammps_error_is_one_line(tmp_path):
                        "GC ERROR: species must be 1, 2 or 3, not 4\n", "", tmp_path, 1)
     assert msg.startswith("GC ERROR: species must be 1, 2 or 3, not 4") and "\n" not in msg
     assert "without an error message" in lammps_error("", "", tmp_path, 9)
+    # the command echoed before the error, found in the deck with its line number (LAMMPS
+    # versions that print the boolean as their "Last input line")
+    deck = ('variable a index 1   # a comment\nif "${a} > 0" then &\n'
+            '   "print \'# not a comment\'"\n')
+    log = ('if "${a} > 0" then    "print \'# not a comment\'"\n'
+           "ERROR: If command boolean can only operate on numbers (src/variable.cpp:5720)\n"
+           "Last input line: abc > 0\n")
+    msg = lammps_error(log, "", tmp_path, 1, deck, "in.x")
+    assert msg.endswith("; in.x line 2: if \"${a} > 0\" then \"print '# not a comment'\""), msg
+    msg = lammps_error(log.replace("if ", "iff ", 1), "", tmp_path, 1, deck, "in.x")
+    assert msg.endswith("; deck line: abc > 0"), msg
 
 
 def test_read_result_still_reads_kept_results():

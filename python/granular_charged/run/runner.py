@@ -240,22 +240,59 @@ def trim_dump(path: Path, before_step: int):
     os.replace(tmp, path)
 
 
-def lammps_error(log_text: str, stderr: str, workdir: Path, returncode: int) -> str:
+def deck_commands(text: str) -> dict[str, int]:
+    """{command: its first line number} of a deck: lines continued with & joined, comments
+    (# outside quotes) dropped, white space collapsed, as LAMMPS echoes them in its log."""
+    out, buf, first = {}, "", 0
+    for n, line in enumerate(text.splitlines(), start=1):
+        first = first or n
+        line = _strip_comment(line).rstrip()
+        if line.endswith("&"):
+            buf += line[:-1] + " "
+            continue
+        command = " ".join((buf + line).split())
+        if command:
+            out.setdefault(command, first)
+        buf, first = "", 0
+    return out
+
+
+def _strip_comment(line: str) -> str:
+    quote = None
+    for k, c in enumerate(line):
+        if quote:
+            quote = None if c == quote else quote
+        elif c in "\"'":
+            quote = c
+        elif c == "#":
+            return line[:k]
+    return line
+
+
+def lammps_error(log_text: str, stderr: str, workdir: Path, returncode: int,
+                 deck: str = "", deck_name: str = "the deck") -> str:
     """One line for a LAMMPS run that failed: the error (the deck's first GC ERROR line, else
     LAMMPS's last ERROR line, from its log, else from the child's exception), the deck line it
-    refers to (LAMMPS's "Last command:") and the run folder. The child's traceback and the
-    log's tail are for -v (the caller logs them at debug level)."""
+    refers to (the command LAMMPS echoed before it, found in the deck's text with its line
+    number, else LAMMPS's "Last command" / "Last input line") and the run folder. The child's
+    traceback and the log's tail are for -v (the caller logs them at debug level)."""
+    commands = deck_commands(deck) if deck else {}
     for lines in (log_text.splitlines(), stderr.splitlines()):
         gc = next((ln.strip() for ln in lines if ln.startswith("GC ERROR")), None)
         if gc:
             return f"{gc} (the run in {workdir})"
         for k in range(len(lines) - 1, -1, -1):
             m = _LAMMPS_ERROR.search(lines[k])
-            if m:
-                last = next((ln.split("Last command:", 1)[1].strip()
-                             for ln in lines[k + 1:k + 4] if "Last command:" in ln), None)
+            if not m:
+                continue
+            before = " ".join(_strip_comment(lines[k - 1]).split()) if k else ""
+            last = next((ln.split(":", 1)[1].strip() for ln in lines[k + 1:k + 4]
+                         if ln.startswith(("Last command:", "Last input line:"))), None)
+            if before in commands:
+                where = f"; {deck_name} line {commands[before]}: {before}"
+            else:
                 where = f"; deck line: {last}" if last else ""
-                return f"LAMMPS stopped the run in {workdir}: {m.group(0).strip()}{where}"
+            return f"LAMMPS stopped the run in {workdir}: {m.group(0).strip()}{where}"
     return (f"LAMMPS run in {workdir} failed (exit {returncode}) without an error message "
             f"(its log: {workdir / 'log.lammps'}; -v shows the child's output)")
 
@@ -325,6 +362,7 @@ class Runner:
         workdir.mkdir(parents=True, exist_ok=True)
         (workdir / "lammps.json").unlink(missing_ok=True)
         with deck_path(deck) as deck_file:
+            deck_text = deck_file.read_text(errors="replace")
             cmd = [sys.executable, "-m", "granular_charged.run.child", str(deck_file), str(workdir),
                    "--kind", kind] + (["--render"] if render else [])
             cmd += child.var_args(variables)
@@ -362,7 +400,8 @@ class Runner:
             tail = "\n".join(text.splitlines()[-15:])
             log.debug("LAMMPS run in %s failed (exit %d); its log ends:\n%s\n%s", workdir,
                       r.returncode, tail, r.stderr[-3000:])
-            raise RunError(lammps_error(text, r.stderr, workdir, r.returncode))
+            raise RunError(lammps_error(text, r.stderr, workdir, r.returncode,
+                                        deck_text, deck))
         out = json.loads(res_file.read_text())
         out["wall_s"] = wall
         # CPU of all ranks; approximate when runs overlap (jobs > 1)
