@@ -269,7 +269,9 @@ def test_a_lammps_error_is_one_line(tmp_path):
     msg = lammps_error("print 'GC ERROR: species must be 1, 2 or 3, not 4'\n"
                        "GC ERROR: species must be 1, 2 or 3, not 4\n", "", tmp_path, 1)
     assert msg.startswith("GC ERROR: species must be 1, 2 or 3, not 4") and "\n" not in msg
-    assert "without an error message" in lammps_error("", "", tmp_path, 9)
+    assert "failed (exit 9): no error message" in lammps_error("", "", tmp_path, 9)
+    said = lammps_error("", "usage: child.py\nchild.py: error: argument --var: bad\n", tmp_path, 2)
+    assert "failed (exit 2): child.py: error: argument --var: bad (its log" in said
     # the command echoed before the error, found in the deck with its line number (LAMMPS
     # versions that print the boolean as their "Last input line")
     deck = ('variable a index 1   # a comment\nif "${a} > 0" then &\n'

@@ -293,8 +293,10 @@ def lammps_error(log_text: str, stderr: str, workdir: Path, returncode: int,
             else:
                 where = f"; deck line: {last}" if last else ""
             return f"LAMMPS stopped the run in {workdir}: {m.group(0).strip()}{where}"
-    return (f"LAMMPS run in {workdir} failed (exit {returncode}) without an error message "
-            f"(its log: {workdir / 'log.lammps'}; -v shows the child's output)")
+    said = next((ln.strip() for ln in reversed(stderr.splitlines()) if ln.strip()), None)
+    return (f"LAMMPS run in {workdir} failed (exit {returncode}): "
+            + (said if said else "no error message")
+            + f" (its log: {workdir / 'log.lammps'}; -v shows the child's output)")
 
 
 def run_folder(p: DepositionParams, root: Path) -> Path:
