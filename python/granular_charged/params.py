@@ -7,7 +7,10 @@ Marshall, J. Comput. Phys. 228 (2009) 1541. SI units throughout.
 from __future__ import annotations
 
 import difflib
+import hashlib
+import json
 import math
+import re
 from dataclasses import asdict, dataclass, field, fields
 
 from .paper import K_EFF
@@ -141,8 +144,53 @@ class DepositionParams:
         return {k: str(v) for k, v in d.items()}
 
     def key(self) -> str:
-        """A file-system friendly name, unique for the parameters: the swept ones always, the
-        far field of a charged run, and every other one that differs from its default."""
+        """The name of the run's folder: the series (r_p, U_0, gamma), q, N and the seed, then
+        ``_h`` and a hash of every non-default value (:meth:`non_default`) when anything else
+        differs from its default or one of those values is not written out exactly: about
+        40-60 characters (at most ~100), the same for the same run however its values are written (``E 2e8`` is
+        ``E 200000000``, a value at its default is the default), different for different runs.
+        The run's params.json and result.json list every value."""
+        canon = self.non_default()
+        head = f"{series_name(self.rp, self.U0, self.gamma)}_q{self.q:g}_N{int(self.N)}_s{int(self.seed)}"
+        exact = (float(f"{self.rp * 1e6:g}e-6") == self.rp and float(f"{self.U0:g}") == self.U0
+                 and float(f"{self.gamma * 1e3:g}e-3") == self.gamma
+                 and float(f"{self.q:g}") == self.q)
+        if set(canon) - set(KEY_MAIN) or not exact:
+            head += "_h" + key_hash(canon)
+        return head
+
+    def non_default(self) -> dict:
+        """Every deck variable of the run whose value differs from its default, {name: value}
+        sorted by name, each value in one form (:func:`normal_value`): the parameter set that
+        the key's hash stands for. A default is the field's (DepositionParams) or the deck's
+        ``variable NAME index DEFAULT``; a default ``${other}`` (species 2's rho_2 is species
+        1's rho) is the run's value of other."""
+        from .run.deckfile import deck_variables
+        deck = deck_variables("in.deposition")
+        given = {k: getattr(self, k) for k in param_names()}
+        given.update(self.extra)
+
+        def default(name, depth=0):
+            if name in _FIELD_DEFAULTS:
+                return _FIELD_DEFAULTS[name]
+            d = deck.get(name)
+            m = _REFERENCE.fullmatch(d or "")
+            if m and depth < 8:
+                ref = m.group(1) or m.group(2)
+                return given[ref] if ref in given else default(ref, depth + 1)
+            return d
+        out = {}
+        for name in sorted(given):
+            value = normal_value(given[name])
+            d = default(name)
+            if d is None or normal_value(d) != value:
+                out[name] = value
+        return out
+
+    def legacy_key(self) -> str:
+        """The folder name of runs made before keys were hashed (every non-default value
+        written out, up to hundreds of characters): such a folder is still found and resumed
+        (runner.run_folder)."""
         base = f"{series_name(self.rp, self.U0, self.gamma)}_q{self.q:g}_N{self.N}_s{self.seed}"
         if self.q or (self.extra and self._population_charged()):
             base += f"_{self.farfield}"
@@ -173,6 +221,34 @@ class DepositionParams:
         d = dimensionless(self.gamma, self.rho, self.U0, self.rp, self.q, K_eff=K)
         d["K_eff"] = K
         return d
+
+
+# the values a run's key always names (the hash stands for every other one)
+KEY_MAIN = ("rp", "U0", "gamma", "q", "N", "seed")
+_FIELD_DEFAULTS = {f.name: f.default for f in fields(DepositionParams) if f.name != "extra"}
+# a deck default that is another variable's value: ${name} or $n
+_REFERENCE = re.compile(r"\$\{(\w+)\}|\$(\w)")
+_NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
+
+
+def normal_value(value):
+    """A deck value in one form, for comparing and hashing: a number (given as a number or as
+    text: 14, "14", "14.0", "1.4e1") as a float, a word list of numbers ("2e-6 4e-6") as a list
+    of floats, other text with its white space collapsed."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return float(value) + 0.0          # -0.0 is 0.0
+    text = " ".join(str(value).split())
+    words = text.split(" ")
+    if text and all(_NUMBER.fullmatch(w) for w in words):
+        numbers = [float(w) + 0.0 for w in words]
+        return numbers[0] if len(numbers) == 1 else numbers
+    return text
+
+
+def key_hash(values: dict) -> str:
+    """10 hex digits of the SHA-1 of a parameter set (canonical JSON: sorted names, compact)."""
+    text = json.dumps(values, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha1(text.encode()).hexdigest()[:10]
 
 
 def population_charged(v: dict) -> bool:

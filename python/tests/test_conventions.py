@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from granular_charged import paper
+from granular_charged.params import DepositionParams
 from granular_charged.analysis import measures
 from granular_charged.figures.conventions import phi0_question
 from granular_charged.studies import conventions
@@ -45,8 +46,11 @@ def test_runs_every_case_and_reuses_the_paper_size_folders():
     study = {p.key() for p in paper_size_params((1, 2, 3), {}, {})}
     x1 = {p.key() for p in ps if p.theta_crit == 0.01}
     assert len(x1) == 12 and x1 <= study
-    # the others as `granular-charged run --var theta_crit 0.04 ...` names them
-    assert "rp2um_U1_g10mJ_q400_N2000_s2_exact_theta_crit0.04" in {p.key() for p in ps}
+    # the others as `granular-charged run --var theta_crit 0.04 ...` names them, and the long
+    # key of their kept runs in doc/data
+    run = DepositionParams(q=400, seed=2, theta_crit=0.04)
+    assert run.key() in {p.key() for p in ps}
+    assert "rp2um_U1_g10mJ_q400_N2000_s2_exact_theta_crit0.04" in {p.legacy_key() for p in ps}
 
 
 def test_case_means_and_the_three_checks(tmp_path):

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from granular_charged.figures.epd import epd_figures
+from granular_charged.params import DepositionParams
 from granular_charged.studies import epd
 
 
@@ -58,7 +59,11 @@ def test_study_runs_every_case_and_seed():
     assert len({p.key() for p in ps}) == len(ps)
     assert all(p.extra["electrode"] == "yes" and p.N == 500 and p.q == 400 for p in ps)
     # the same folders as `granular-charged run --var L_rp 14 --var E0 1e5 --var eps_p 3.8 ...`
-    assert any(p.key().endswith("_E01e5_L_rp14_electrodeyes_eps_p3.8") for p in ps)
+    run = DepositionParams(q=400, N=500, seed=1, extra={"L_rp": "14", "E0": "1e5",
+                                                        "eps_p": "3.8", "electrode": "yes"})
+    assert run.key() in {p.key() for p in ps}
+    # the long key of the kept runs in doc/data
+    assert any(p.legacy_key().endswith("_E01e5_L_rp14_electrodeyes_eps_p3.8") for p in ps)
 
 
 def test_figures_draw_every_case_and_the_orientation(tmp_path):

@@ -20,8 +20,10 @@ def test_the_study_asks_for_neutral_default_and_sequential_runs():
     seq = [p for p in ps if p.extra.get("inject") == "sequential"]
     assert sorted({p.q for p in seq}) == [260.0, 400.0] and len(seq) == 6
     # the default runs are reproduce --size paper's folders: no inject, no L_rp in the key
-    assert "rp2um_U1_g10mJ_q400_N2000_s1_exact" in keys
+    assert "rp2um_U1_g10mJ_q400_N2000_s1" in keys
     assert "rp2um_U1_g10mJ_q0_N2000_s1" in keys
+    # and the kept runs of doc/data under the long key
+    assert "rp2um_U1_g10mJ_q400_N2000_s1_exact_injectsequential" in {p.legacy_key() for p in ps}
     assert all(p.N == 2000 for p in ps)
 
 

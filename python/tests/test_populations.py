@@ -19,9 +19,9 @@ from lammps_runs import SRC, lmp_run
 # ---- without LAMMPS ---------------------------------------------------------------------------
 
 def test_default_run_keys_do_not_change():
-    # the kept runs of doc/data are found by these names
+    # the kept runs of doc/data are found by these names (the long key of the second)
     assert DepositionParams().key() == "rp2um_U1_g10mJ_q0_N2000_s4711"
-    assert DepositionParams(q=400, N=500, seed=2, extra={"L_rp": "14"}).key() == \
+    assert DepositionParams(q=400, N=500, seed=2, extra={"L_rp": "14"}).legacy_key() == \
         "rp2um_U1_g10mJ_q400_N500_s2_exact_L_rp14"
 
 

@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 
 from conftest import SRC
+from granular_charged.params import DepositionParams
 
 TINY = ["--N", 5, "--seed", 1, "--var", "L_rp", 6, "--var", "H_rp", 30, "--no-render"]
 # ke_stop 0: no stop before the settling time settle_max r_p / U_0 (~330 steps per unit)
@@ -67,7 +68,8 @@ def test_material_var_is_the_run_parameter(cli, tmp_path):
     assert res["params"]["farfield"] == "average" and res["params"]["rho"] == 3000.0
     assert res["params"]["q"] == 100.0 and res["params"]["extra"] == {"L_rp": "6", "H_rp": "30"}
     assert res["groups"]["Ad"] == pytest.approx(0.010 / (3000 * 1.0 * 2e-6), rel=1e-12)
-    assert res["key"] == "rp2um_U1_g10mJ_q100_N5_s1_average_H_rp30_L_rp6_rho3000"
+    assert res["key"] == DepositionParams(q=100, N=5, seed=1, farfield="average", rho=3000,
+                                          extra={"L_rp": "6", "H_rp": "30"}).key()
     log = (rf.parent / "log.lammps").read_text()
     assert "farfield average" in log                  # fix coul/fmm's line as LAMMPS ran it
     mass = [ln for ln in log.splitlines() if ln.startswith("variable mass")]
@@ -81,7 +83,8 @@ def test_two_commands_on_one_run_take_turns(build_dir, tmp_path):
     finds the run finished. Both exit 0 and the folder holds one complete run."""
     args = ["run", "--out", tmp_path / "runs", *LONG]
     first = _popen(build_dir, args, tmp_path)
-    wd = tmp_path / "runs" / "rp2um_U1_g10mJ_q0_N5_s1_H_rp30_L_rp6_ke_stop0_settle_max3000"
+    wd = tmp_path / "runs" / DepositionParams(N=5, seed=1, extra={
+        "H_rp": "30", "L_rp": "6", "ke_stop": "0", "settle_max": "3000"}).key()
     _wait_for(lambda: (wd / "log.lammps").exists() or first.poll() is not None, 60,
               "the first run's log.lammps")
     assert first.poll() is None, "the first run ended before the second started: make LONG longer"

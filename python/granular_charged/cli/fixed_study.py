@@ -7,7 +7,7 @@ import logging
 from pathlib import Path
 
 from ..run.runner import Runner
-from ..studies.sweep import Sweep, load_results
+from ..studies.sweep import Sweep, finished_results
 from . import options
 
 log = logging.getLogger("granular_charged")
@@ -31,8 +31,7 @@ def study_runs(a, params) -> tuple[Path, list[dict]]:
     runs = out / "runs"
     if not a.finished_only:
         Sweep(options.runner(a, not a.no_render), runs, engine=options.engine(a)).run(params)
-    keys = {p.key() for p in params}
-    results = [r for r in load_results(runs) if r["key"] in keys] if runs.exists() else []
+    results = finished_results(params, runs) if runs.exists() else []
     if not results:
         log.error("no finished runs of the study in %s", runs)
     return out, results

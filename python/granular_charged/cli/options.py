@@ -4,6 +4,7 @@ studies' options; --var pairs checked against the deck, output folders, the runn
 from __future__ import annotations
 
 import argparse
+import re
 from pathlib import Path
 
 from ..params import ParamError, split_deck_vars
@@ -43,9 +44,17 @@ def common() -> argparse.ArgumentParser:
     return p
 
 
+# a number written with a minus sign (-2, -.5, -2e-7, -1E+3): an option's value, never an
+# option (argparse's own rule takes -2e-7 for an option name: `--var q_sigma -2e-7` failed)
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+
+
 def add_command(subparsers, name: str, **kwargs) -> argparse.ArgumentParser:
-    """A subcommand's parser, with the common options."""
-    return subparsers.add_parser(name, parents=[common()], **kwargs)
+    """A subcommand's parser, with the common options; a negative number (-2e-7) after an
+    option is its value."""
+    p = subparsers.add_parser(name, parents=[common()], **kwargs)
+    p._negative_number_matcher = NEGATIVE_NUMBER
+    return p
 
 
 def deck_options(p: argparse.ArgumentParser, many: bool):

@@ -38,7 +38,8 @@ def run(a) -> int:
     out = options.out_dir(a.out)
     runner = options.runner(a, not a.no_render)
     runner.show_progress = a.progress
-    log.info("run %s in %s (LAMMPS build %s)", p.key(), out.resolve(), runner.build.path)
+    log.info("run %s in %s (LAMMPS build %s)", p.key(), runner.workdir(p, out).resolve(),
+             runner.build.path)
     try:
         r = runner.deposition(p, out, force=a.force, tracer=a.tracer, lock=True)
     except RunError as e:

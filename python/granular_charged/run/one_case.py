@@ -31,9 +31,9 @@ def run(plan_path: str, folder: str) -> int:
                         checkpoint=plan["checkpoint"])
         if job["kind"] == "deposition":
             p = DepositionParams(**job["params"])
-            if p.key() != wd.name:
+            if wd.name not in (p.key(), p.legacy_key()):
                 raise ParamError(f"{wd}: the folder of run {p.key()} must be named after it")
-            runner.deposition(p, wd.parent, tracer=job["tracer"])
+            runner.deposition(p, wd.parent, tracer=job["tracer"], folder=wd)
         else:
             run_table2(runner, root / job["formed"], job["qs"], wd, job["extra"])
     except (RunError, ParamError, BuildError, OSError) as e:

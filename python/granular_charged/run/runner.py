@@ -19,6 +19,7 @@ import json
 import logging
 import math
 import os
+import re
 import resource
 import shutil
 import subprocess
@@ -29,7 +30,7 @@ from pathlib import Path
 
 from ..analysis import packing
 from ..params import DepositionParams, ParamError, coulomb_to_adhesion
-from . import population
+from . import child, population
 from .deckfile import deck_path, deck_variables
 from .lammps_build import LammpsBuild
 from .logs import read_new_lines
@@ -57,6 +58,12 @@ RESULT_KEYS = ("key", "params", "groups", "phi", "Z", "fZ", "inserted", "natoms"
 PARAM_KEYS = ("rp", "U0", "gamma", "q", "N", "seed")
 # the environment variable through which a LAMMPS child learns its parent (child.py watches it)
 PARENT_ENV = "GC_PARENT_PID"
+# LAMMPS's error lines (Error::all, Error::one), also inside the child's exception
+_LAMMPS_ERROR = re.compile(r"ERROR( on proc \d+)?: .*")
+# a run's parameters, in its folder beside result.json (write_params)
+PARAMS_FILE = "params.json"
+# the longest file name (bytes) of the usual file systems
+NAME_MAX = 255
 
 
 class RunError(RuntimeError):
@@ -233,6 +240,88 @@ def trim_dump(path: Path, before_step: int):
     os.replace(tmp, path)
 
 
+def deck_commands(text: str) -> dict[str, int]:
+    """{command: its first line number} of a deck: lines continued with & joined, comments
+    (# outside quotes) dropped, white space collapsed, as LAMMPS echoes them in its log."""
+    out, buf, first = {}, "", 0
+    for n, line in enumerate(text.splitlines(), start=1):
+        first = first or n
+        line = _strip_comment(line).rstrip()
+        if line.endswith("&"):
+            buf += line[:-1] + " "
+            continue
+        command = " ".join((buf + line).split())
+        if command:
+            out.setdefault(command, first)
+        buf, first = "", 0
+    return out
+
+
+def _strip_comment(line: str) -> str:
+    quote = None
+    for k, c in enumerate(line):
+        if quote:
+            quote = None if c == quote else quote
+        elif c in "\"'":
+            quote = c
+        elif c == "#":
+            return line[:k]
+    return line
+
+
+def lammps_error(log_text: str, stderr: str, workdir: Path, returncode: int,
+                 deck: str = "", deck_name: str = "the deck") -> str:
+    """One line for a LAMMPS run that failed: the error (the deck's first GC ERROR line, else
+    LAMMPS's last ERROR line, from its log, else from the child's exception), the deck line it
+    refers to (the command LAMMPS echoed before it, found in the deck's text with its line
+    number, else LAMMPS's "Last command" / "Last input line") and the run folder. The child's
+    traceback and the log's tail are for -v (the caller logs them at debug level)."""
+    commands = deck_commands(deck) if deck else {}
+    for lines in (log_text.splitlines(), stderr.splitlines()):
+        gc = next((ln.strip() for ln in lines if ln.startswith("GC ERROR")), None)
+        if gc:
+            return f"{gc} (the run in {workdir})"
+        for k in range(len(lines) - 1, -1, -1):
+            m = _LAMMPS_ERROR.search(lines[k])
+            if not m:
+                continue
+            before = " ".join(_strip_comment(lines[k - 1]).split()) if k else ""
+            last = next((ln.split(":", 1)[1].strip() for ln in lines[k + 1:k + 4]
+                         if ln.startswith(("Last command:", "Last input line:"))), None)
+            if before in commands:
+                where = f"; {deck_name} line {commands[before]}: {before}"
+            else:
+                where = f"; deck line: {last}" if last else ""
+            return f"LAMMPS stopped the run in {workdir}: {m.group(0).strip()}{where}"
+    said = next((ln.strip() for ln in reversed(stderr.splitlines()) if ln.strip()), None)
+    return (f"LAMMPS run in {workdir} failed (exit {returncode}): "
+            + (said if said else "no error message")
+            + f" (its log: {workdir / 'log.lammps'}; -v shows the child's output)")
+
+
+def run_folder(p: DepositionParams, root: Path) -> Path:
+    """The folder of run p under root: root/<p.key()>, or the folder named by the key of
+    earlier versions (p.legacy_key(), every non-default value written out) when only that one
+    exists and holds the run's result.json or a restart point: a run made then is found,
+    reused and resumed. Every command finds a run's folder here."""
+    root = Path(root)
+    new = root / p.key()
+    legacy = p.legacy_key()
+    if legacy == new.name or len(os.fsencode(legacy)) > NAME_MAX or new.exists():
+        return new
+    old = root / legacy
+    if (old / "result.json").exists() or (old / CHECKPOINT_VARS).exists():
+        return old
+    return new
+
+
+def write_params(wd: Path, p: DepositionParams):
+    """params.json in a run's folder: its key, every value that differs from its default (the
+    key's hash stands for them), every deck variable as the deck receives it."""
+    write_json(Path(wd) / PARAMS_FILE, {"key": p.key(), "non_default": p.non_default(),
+                                        "deck_vars": p.deck_vars()})
+
+
 def parse_progress(line: str) -> dict | None:
     """{'k', 'N', 'step', 'elapsed', 'eta'} of a GC PROGRESS line of in.deposition:
     'GC PROGRESS k / N particles, step S, elapsed T s, eta T s'."""
@@ -275,10 +364,10 @@ class Runner:
         workdir.mkdir(parents=True, exist_ok=True)
         (workdir / "lammps.json").unlink(missing_ok=True)
         with deck_path(deck) as deck_file:
+            deck_text = deck_file.read_text(errors="replace")
             cmd = [sys.executable, "-m", "granular_charged.run.child", str(deck_file), str(workdir),
                    "--kind", kind] + (["--render"] if render else [])
-            for k, v in variables.items():
-                cmd += ["--var", str(k), str(v)]
+            cmd += child.var_args(variables)
             if self.np_ranks > 1:
                 mpirun = shutil.which("mpirun") or shutil.which("mpiexec")
                 if not mpirun:
@@ -311,8 +400,10 @@ class Runner:
             if inner.exists() and "GC RESULT" not in text:
                 text += "\n" + inner.read_text(errors="replace")
             tail = "\n".join(text.splitlines()[-15:])
-            raise RunError(f"LAMMPS run in {workdir} failed (exit {r.returncode}):\n{tail}\n"
-                           f"{r.stderr[-1500:]}")
+            log.debug("LAMMPS run in %s failed (exit %d); its log ends:\n%s\n%s", workdir,
+                      r.returncode, tail, r.stderr[-3000:])
+            raise RunError(lammps_error(text, r.stderr, workdir, r.returncode,
+                                        deck_text, deck))
         out = json.loads(res_file.read_text())
         out["wall_s"] = wall
         # CPU of all ranks; approximate when runs overlap (jobs > 1)
@@ -382,7 +473,7 @@ class Runner:
 
     # ---- one deposition -------------------------------------------------------------------
     def workdir(self, p: DepositionParams, root: Path) -> Path:
-        return Path(root) / p.key()
+        return run_folder(p, root)
 
     def finished(self, p: DepositionParams, root: Path) -> dict | None:
         return read_result(self.workdir(p, root) / "result.json")
@@ -401,16 +492,17 @@ class Runner:
             raise ParamError(f"tracer = {tracer}: must be a particle id 1..N = {p.N} (0: none)")
 
     def deposition(self, p: DepositionParams, root: Path, force: bool = False,
-                   tracer: int = 0, lock: bool = False) -> dict:
-        """Run in.deposition for p in root/<p.key()>, analyse, write result.json, return it.
+                   tracer: int = 0, lock: bool = False, folder: Path | None = None) -> dict:
+        """Run in.deposition for p in its folder under root (run_folder; ``folder``: this one,
+        the case's folder of the engine), analyse, write result.json, return it.
         A complete result.json is returned unchanged (with 'skipped': True) unless force.
         lock: hold root/.<key>.lock meanwhile (folder_lock; the `run` command, which runs
         outside the workflow engine and its lock)."""
         self.check(p, tracer)
-        wd = self.workdir(p, root)
+        wd = Path(folder) if folder is not None else self.workdir(p, root)
         if not lock:
             return self._deposition(p, wd, force, tracer)
-        with folder_lock(Path(root) / f".{wd.name}.lock", p.key()):
+        with folder_lock(Path(root) / f".{p.key()}.lock", p.key()):
             return self._deposition(p, wd, force, tracer)
 
     def _deposition(self, p: DepositionParams, wd: Path, force: bool, tracer: int) -> dict:
@@ -434,6 +526,8 @@ class Runner:
         if tracer:
             variables["tracer"] = str(tracer)
         restart_note = None
+        wd.mkdir(parents=True, exist_ok=True)
+        write_params(wd, p)
         try:
             pieces = self._begin_piece(wd, point, variables)
             lmp = self.run_deck("in.deposition", wd, variables, kind="deposition",
@@ -447,6 +541,8 @@ class Runner:
                             "the run started afresh")
             log.warning("%s: %s", p.key(), restart_note)
             shutil.rmtree(wd)
+            wd.mkdir(parents=True)
+            write_params(wd, p)
             variables.pop("resume", None)
             point = None
             pieces = self._begin_piece(wd, None, variables)
@@ -541,7 +637,7 @@ class Runner:
         from_lammps = lmp.get("phi") is not None
         res = {
             "version": RESULT_VERSION, "complete": True, "key": p.key(),
-            "params": {k: v for k, v in vars(p).items()},
+            "params": {k: v for k, v in vars(p).items()}, "non_default": p.non_default(),
             "groups": p.groups(), "FC_over_FE": coulomb_to_adhesion(p.gamma, p.rp, p.q),
             "lammps": lmp, "python": py,
             "source": ("lammps computes" if from_lammps

@@ -23,10 +23,13 @@ def deck_params(pairs, base: dict, popvars: dict, refused: dict, N: int, seed: i
     fields, extra = split_deck_vars(list(pairs), deck_variables("in.deposition"), refused)
     fields = dict(base, **fields)
     for k, v in popvars.items():
-        if k in param_names():
-            fields[k] = type(getattr(DepositionParams, k))(float(v)) if k not in ("farfield",) else v
-        else:
-            extra[k] = v
+        if k == "farfield" or k not in param_names():
+            (fields if k == "farfield" else extra)[k] = v
+            continue
+        try:
+            fields[k] = type(getattr(DepositionParams, k))(float(v))
+        except (TypeError, ValueError):
+            raise ParamError(f"{k} = {v!r}: must be a number") from None
     return DepositionParams(N=N, seed=seed, extra=extra, **fields)
 
 

@@ -22,7 +22,7 @@ from ..params import DepositionParams
 from ..run.after_formation import load_table2
 from ..run.runner import Runner
 from .engine import MIN_MINUTES, Engine, deposition_cases, table2_case
-from .sweep import describe_result, finished_results
+from .sweep import describe_result, finished_results, in_run_folders
 
 log = logging.getLogger(__name__)
 
@@ -126,7 +126,8 @@ class Study:
         seeds = self.table2_seeds() if have_fmm and qs else ()
         for p in params:
             runner.check(p, self.tracer(p))
-        cases = deposition_cases(params, "runs", runner.np_ranks, self.tracer, [out / "runs"])
+        cases = in_run_folders(deposition_cases(params, "runs", runner.np_ranks, self.tracer,
+                                                [out / "runs"]), params, out / "runs")
         checks = []
         for seed in seeds:
             formed = next((c for p, c in zip(params, cases) if p.seed == seed and all(

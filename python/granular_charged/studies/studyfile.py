@@ -26,6 +26,8 @@ from .sweep import Sweep
 
 log = logging.getLogger(__name__)
 
+# the grid's entry whose variables vary together (one axis)
+TOGETHER = "together"
 TOP_KEYS = {"name", "out", "seeds", "N", "protocol", "deck", "material", "population",
             "species", "grid"}
 
@@ -49,10 +51,74 @@ def load(path) -> dict:
     d.setdefault("protocol", "auto")
     if d["protocol"] not in ("auto", "rain", "plane", "sequential"):
         raise ParamError(f"{path}: protocol must be auto, rain, plane or sequential")
-    for k, v in d.get("grid", {}).items():
-        if not isinstance(v, list) or not v:
-            raise ParamError(f"{path}: grid.{k} must be a non-empty list of values")
+    seeds = d["seeds"]
+    if not (isinstance(seeds, list) and seeds and all(
+            isinstance(s, int) and not isinstance(s, bool) and s >= 1 for s in seeds)):
+        raise ParamError(f"{path}: seeds = {seeds!r}: must be a non-empty list of whole numbers "
+                         ">= 1, e.g. seeds = [1, 2, 3]")
+    d["axes"] = grid_axes(d.get("grid", {}), path)
+    # every varied variable with its values, in the file's order (the tables' and figures' axes)
+    d["grid"] = {k: v for axis in d["axes"] for k, v in axis.items()}
     return d
+
+
+def grid_axes(grid: dict, path) -> list[dict]:
+    """The grid's axes, each {name: values}: a plain entry (name = [values]) is an axis of one
+    variable; a `together` table ({name = [values], ...}, or a list of such tables) is one axis
+    whose variables take their i-th values together. The runs are every combination of the
+    axes' points. ParamError for an entry that is not a non-empty list, together lists of
+    different lengths, a variable given twice."""
+    axes, seen = [], set()
+
+    def values(name, v, where):
+        if not isinstance(v, list) or not v:
+            raise ParamError(f"{path}: {where}{name} = {v!r}: must be a non-empty list of values")
+        if name in seen:
+            raise ParamError(f"{path}: grid: {name} is given twice (an axis of its own and "
+                             "together, or in two together tables)")
+        seen.add(name)
+        return v
+
+    for name, v in grid.items():
+        if name != TOGETHER:
+            axes.append({name: values(name, v, "grid.")})
+            continue
+        groups = v if isinstance(v, list) else [v]
+        for group in groups:
+            if not isinstance(group, dict) or not group:
+                raise ParamError(f"{path}: grid.{TOGETHER} must be a table of lists of equal "
+                                 "length, e.g. together = {q_sigma = [0, -2e-7], "
+                                 "q_sigma_2 = [0, 3e-7]}")
+            axis = {k: values(k, x, f"grid.{TOGETHER}.") for k, x in group.items()}
+            lengths = {k: len(x) for k, x in axis.items()}
+            if len(set(lengths.values())) > 1:
+                raise ParamError(f"{path}: grid.{TOGETHER}: its lists vary together and need "
+                                 "one length each, not "
+                                 + ", ".join(f"{k} {n}" for k, n in lengths.items()))
+            axes.append(axis)
+    return axes
+
+
+def deck_text(name: str, value) -> str:
+    """A study file's value as the deck's text: a number as written back by Python (-2e-07),
+    a list as a word list ("2e-06 4e-06"), true/false as yes/no, text unchanged."""
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, list):
+        return " ".join(deck_text(name, v) for v in value)
+    if isinstance(value, (int, float, str)):
+        return str(value)
+    raise ParamError(f"{name} = {value!r}: must be a number, a word or a list of them")
+
+
+def number(name: str, value) -> float:
+    """A study file's value that must be a number, as a float (ParamError naming it)."""
+    try:
+        if isinstance(value, bool):
+            raise ValueError
+        return float(value)
+    except (TypeError, ValueError):
+        raise ParamError(f"{name} = {value!r}: must be a number") from None
 
 
 def params(d: dict) -> list[DepositionParams]:
@@ -75,24 +141,28 @@ def params(d: dict) -> list[DepositionParams]:
     fixed = dict(d.get("deck", {}))
     for k in ("rp", "U0", "gamma", "q"):
         if k in fixed:
-            base[k] = float(fixed.pop(k))
-    N = int(fixed.pop("N", d.get("N", 500)))
+            base[k] = number(f"deck.{k}", fixed.pop(k))
+    N = fixed.pop("N", d.get("N", 500))
+    if not (isinstance(N, int) and not isinstance(N, bool) and N >= 1):
+        raise ParamError(f"N = {N!r}: must be a whole number >= 1 (particles per run)")
     refused = dict(RESERVED, seed="seeds = [...] of the study file")
-    grid = d.get("grid", {})
-    names = list(grid)
+    axes = d.get("axes") or grid_axes(d.get("grid", {}), "study")
+    # each axis's points: [{name: value}, ...] (a together axis: the i-th values of its lists)
+    points = [[dict(zip(axis, vals)) for vals in zip(*axis.values())] for axis in axes]
     out = []
-    for vals in itertools.product(*grid.values()):
+    for combo in itertools.product(*points):
+        point = {k: v for p in combo for k, v in p.items()}
         for seed in d["seeds"]:
             b = dict(base)
-            pairs = [(k, str(v)) for k, v in fixed.items()]
+            pairs = [(k, deck_text(f"deck.{k}", v)) for k, v in fixed.items()]
             pv = dict(popvars)
-            for k, v in zip(names, vals):
+            for k, v in point.items():
                 if k in ("U0", "gamma", "q", "rp") and k not in pv:
-                    b[k] = float(v)
+                    b[k] = number(f"grid.{k}", v)
                 elif k in pv or k in param_names():
-                    pv[k] = str(v)
+                    pv[k] = deck_text(f"grid.{k}", v)
                 else:
-                    pairs.append((k, str(v)))
+                    pairs.append((k, deck_text(f"grid.{k}", v)))
             out.append(deck_params(pairs, b, pv, refused, N, int(seed)))
     return list({p.key(): p for p in out}.values())
 

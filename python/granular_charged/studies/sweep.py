@@ -14,7 +14,7 @@ from pathlib import Path
 from types import MappingProxyType
 
 from ..params import DepositionParams
-from ..run.runner import Runner, load_result_files, read_result
+from ..run.runner import Runner, load_result_files, read_result, run_folder
 from .engine import Engine, deposition_cases
 
 log = logging.getLogger(__name__)
@@ -63,16 +63,28 @@ class Sweep:
         to follow, or a function of the DepositionParams giving it."""
         for p in params:          # every run checked before the first starts
             self.runner.check(p, tracer(p) if callable(tracer) else tracer)
-        cases = deposition_cases(params, "", self.runner.np_ranks, tracer, [self.out])
+        cases = in_run_folders(deposition_cases(params, "", self.runner.np_ranks, tracer,
+                                                [self.out]), params, self.out)
         self.engine.run(self.out, cases, self.runner, describe=describe_result)
         return finished_results(params, self.out)
 
 
+def in_run_folders(cases, params, root: Path) -> list:
+    """The deposition cases (of params, in that order) in their runs' folders under root
+    (runner.run_folder: a run kept under the long key of earlier versions is resumed there)."""
+    for c, p in zip(cases, params):
+        parent = str(Path(c.folder).parent)
+        name = run_folder(p, root).name
+        c.folder = name if parent == "." else f"{parent}/{name}"
+    return cases
+
+
 def finished_results(params, out: Path) -> list[dict]:
-    """The finished results of params in out/<key>/ (with 'dir'), in the order of params."""
+    """The finished results of params in their folders under out (runner.run_folder), each
+    with 'dir', in the order of params."""
     results = []
     for p in params:
-        wd = Path(out) / p.key()
+        wd = run_folder(p, out)
         r = read_result(wd / "result.json")
         if r is not None:
             r["dir"] = str(wd)
