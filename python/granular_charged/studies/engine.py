@@ -244,7 +244,8 @@ class Engine:
         return {"finished": sorted(map(str, finished)), "failed": failed}
 
     def _snakemake(self, cmd, root: Path, quiet=False) -> subprocess.CompletedProcess:
-        r = subprocess.run(cmd, env=_job_env(), capture_output=True, text=True)
+        r = subprocess.run(cmd, env=_job_env(), capture_output=True, text=True,
+                           preexec_fn=_die_with_parent(signal.SIGKILL))
         if r.returncode != 0 and not quiet:
             raise EngineError(f"Snakemake failed in {root} (exit {r.returncode}):\n"
                               f"{(r.stdout + r.stderr)[-3000:]}")
