@@ -271,7 +271,7 @@ class Engine:
         Snakemake ends with this process, however it ends: it stays in this process's group
         (a signal to the group, such as Ctrl-C at a terminal or a kill of the whole command,
         reaches it and its local jobs), and it has a parent-death signal (this process killed
-        alone: SIGKILL locally; SIGINT with a batch system, on which Snakemake cancels its
+        alone: SIGKILL locally; SIGINT with a batch system, on which Snakemake tries to cancel its
         submitted jobs). Each job runs under a guard (``--guard``) that ends it when this
         process has ended."""
         logfile = root / PLAN_DIR / f"snakemake-{time.strftime('%Y%m%d-%H%M%S')}-{os.getpid()}.log"
@@ -313,15 +313,19 @@ class Engine:
                 # Ctrl-C at a terminal reached Snakemake and its local jobs with this process;
                 # anything else (a signal to this process alone, an error) is passed on. Its
                 # running jobs stop, their targets stay missing.
-                _stop(proc)
+                _stop(proc, local=not (self.slurm or self.cluster))
                 alive.unlink(missing_ok=True)
                 raise
 
 
-def _stop(proc: subprocess.Popen):
-    """Stop a Snakemake that this process is leaving: SIGINT (it stops its jobs, cancels
-    submitted ones), SIGKILL when it has not ended after a while."""
-    for sig, wait in ((None, 2), (signal.SIGINT, 30), (signal.SIGKILL, None)):
+def _stop(proc: subprocess.Popen, local: bool):
+    """Stop a Snakemake that this process is leaving. After a Ctrl-C it ends by itself. Else,
+    locally SIGKILL (its jobs end with this process, by their guard; a local Snakemake given
+    SIGINT would wait for them); with a batch system SIGINT, on which it tries to cancel the jobs
+    it submitted; SIGKILL when it has not ended after a while."""
+    steps = ((None, 5), (signal.SIGKILL, None)) if local else \
+        ((None, 10), (signal.SIGINT, 30), (signal.SIGKILL, None))
+    for sig, wait in steps:
         if proc.poll() is not None:
             return
         if sig is not None:
