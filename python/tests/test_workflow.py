@@ -102,6 +102,9 @@ def test_killed_study_leaves_nothing_running_and_resumes_with_only_its_missing_r
     out = tmp_path / "study"
     proc = start(build_dir, STUDY3 + ["--out", out, "--jobs", 1], tmp_path)
     wait_for(lambda: len(results(out)) >= 1, proc, 300, "the first run")
+    # while the second one runs in LAMMPS
+    wait_for(lambda: any("granular_charged.run.child" in p for p in study_processes(out)),
+             proc, 300, "the second run")
     running = study_processes(out)
     assert any("snakemake" in p for p in running), running
     t0 = time.monotonic()
