@@ -57,8 +57,9 @@ def main(argv=None) -> int:
     except DryRunDone:
         return 0
     except EngineError as e:
+        # 1: the engine could not start; 3: it stopped on its own error (no case failed)
         log.error("granular-charged %s: %s", a.command, e)
-        return 1
+        return e.status
     except ParamError as e:
         # before any run: nothing was started or written
         log.error("granular-charged %s: %s", a.command, e)

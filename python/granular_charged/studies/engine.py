@@ -11,6 +11,11 @@ missing cases), at most ``--jobs`` cases (or cores) at a time locally, one Slurm
 through a ``--cluster`` submission template, ``--dry-run``, and a lock on the study's folder that
 refuses a second study writing the same cases.
 
+The engine and its jobs end with the command that started them, however it ends (Engine._watch,
+guard), so a killed study leaves nothing running; a second command on the folder of a running
+one names that command's PID. A failure of Snakemake itself (EngineFailed: its first error line
+and what it means) is told apart from a failure of a case (failed.txt in its folder).
+
 Why Snakemake: a case already is a folder with a result file, which is exactly Snakemake's unit
 (file targets, rerun when missing); it is in Debian 12 beside the package's other dependencies;
 it submits to Slurm natively (7.21: ``--slurm``) and to other schedulers by template, from the
@@ -18,15 +23,18 @@ same command that runs on a laptop.
 """
 from __future__ import annotations
 
+import ctypes
 import json
 import logging
 import math
 import os
+import re
 import shlex
 import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,9 +51,18 @@ from ..run.runner import read_result
 log = logging.getLogger(__name__)
 
 SNAKEFILE = Path(__file__).resolve().parent / "Snakefile"
+# what each job's command runs in (guard): the job ends when the study's command has ended
+GUARD = f"{shlex.quote(sys.executable)} -m granular_charged.studies.engine --guard --"
 # the plans and Snakemake's log of each study, inside the study's folder
 PLAN_DIR = ".gc-workflow"
 LOCKED = "cannot be locked"
+# the command that started a study's engine, HOST:PID:START (START: the process's start time,
+# so that a reused PID is not taken for it); each job of the engine ends when it has ended
+OWNER_ENV = "GC_STUDY_OWNER"
+# how often a job's guard looks whether that command is still there [s]
+GUARD_POLL = 0.25
+# the exit status of a command whose engine failed (a failed case: 1)
+ENGINE_FAILED_STATUS = 3
 # a Slurm time limit: the estimate's upper bound times this, at least this many minutes
 TIME_MARGIN = 2.0
 MIN_MINUTES = 10
@@ -53,6 +70,13 @@ MIN_MINUTES = 10
 
 class EngineError(RuntimeError):
     """The workflow engine could not run the study (missing, locked folder, bad cluster options)."""
+    status = 1
+
+
+class EngineFailed(EngineError):
+    """The engine itself stopped (Snakemake's own error, not a case's): the cases it did not run
+    are not failed, they run when the same command is run again."""
+    status = ENGINE_FAILED_STATUS
 
 
 class DryRunDone(Exception):
@@ -105,7 +129,7 @@ class Engine:
         plan_dir = root / PLAN_DIR
         plan_dir.mkdir(parents=True, exist_ok=True)
         path = plan_dir / f"plan-{os.getpid()}-{time.time_ns()}.json"
-        command = (f"{shlex.quote(sys.executable)} -m granular_charged.run.one_case "
+        command = (f"{GUARD} {shlex.quote(sys.executable)} -m granular_charged.run.one_case "
                    f"{shlex.quote(str(path))}")
         plan = {"root": str(root), "build_dir": str(runner.build.path), "render": runner.render,
                 "checkpoint": runner.checkpoint, "timeout": runner.timeout, "command": command,
@@ -156,7 +180,8 @@ class Engine:
     def run(self, root: Path, cases: list[Case], runner, describe=None) -> dict:
         """Run the cases not finished in root; returns {'finished': targets that exist,
         'failed': {folder: error}}. ``describe(path)``: a log line for a finished target (None:
-        nothing). Raises EngineError when Snakemake cannot start or the folder is locked."""
+        nothing). Raises EngineError when Snakemake cannot start or the folder is locked, and
+        EngineFailed when Snakemake itself stopped before running every case."""
         root = Path(root).resolve()
         root.mkdir(parents=True, exist_ok=True)
         for c in cases:
@@ -179,38 +204,48 @@ class Engine:
                 return {"finished": sorted(map(str, before)), "failed": {}}
             rc, logfile = self._watch(root, plan, targets, before, describe)
             if rc != 0 and LOCKED in logfile.read_text(errors="replace") \
-                    and not _engines_alive(root):
+                    and not live_engines(root):
                 # the lock of an engine that is gone (killed with its node): nothing holds it
                 log.warning("%s: the lock left by a study that was killed is removed", root)
                 self._snakemake(self.command(root, plan) + ["--unlock"], root)
                 rc, logfile = self._watch(root, plan, targets, before, describe)
         finally:
             plan.unlink(missing_ok=True)
-        finished = [t for t in targets if t.exists()]
-        failed = {}
-        for c in cases:
-            if not (root / c.target).exists():
-                msg = root / c.folder / FAILED
-                failed[c.folder] = (msg.read_text(errors="replace").strip() if msg.exists()
-                                    else f"not finished (Snakemake's log: {logfile})")
         text = logfile.read_text(errors="replace") if logfile.exists() else ""
         if rc != 0 and LOCKED in text:
-            raise EngineError(
-                f"{root}: another study is writing these cases now (Snakemake's lock on the "
-                "folder); wait for it to end. If none is running (one was killed), run the "
-                "same command again with --unlock")
-        if rc != 0 and not failed:
-            tail = "\n".join(text.splitlines()[-20:])
-            raise EngineError(f"Snakemake failed (exit {rc}, log {logfile}):\n{tail}")
+            raise EngineError(locked_message(root, live_engines(root)))
+        finished = [t for t in targets if t.exists()]
+        # a case failed when its job did (Snakemake's "Error in rule" names its target); one
+        # the engine did not get to is not failed, whatever an earlier study left in its folder
+        errored = failed_jobs(text)
+        failed, not_run = {}, []
+        for c in cases:
+            if (root / c.target).exists():
+                continue
+            if c.target in errored:
+                msg = root / c.folder / FAILED
+                failed[c.folder] = (msg.read_text(errors="replace").strip() if msg.exists()
+                                    else f"its job failed (Snakemake's log: {logfile})")
+            else:
+                not_run.append(c.folder)
         for folder, err in failed.items():
             log.error("case FAILED %s: %s", folder, err)
         if failed:
             log.warning("%d of %d cases failed (run the same command again to retry them)",
                         len(failed), len(cases))
+        error = engine_error(text) if rc != 0 else None
+        if (rc != 0 and (error or not failed or (not_run and self.keep_going))) \
+                or (rc == 0 and not_run):
+            # Snakemake's own failure: its cases are not failed, they are still to run
+            raise EngineFailed(failure_message(rc, error, not_run, len(cases), logfile))
+        if not_run:
+            log.warning("%d of %d cases did not run: the study stops at its first failed case",
+                        len(not_run), len(cases))
         return {"finished": sorted(map(str, finished)), "failed": failed}
 
     def _snakemake(self, cmd, root: Path, quiet=False) -> subprocess.CompletedProcess:
-        r = subprocess.run(cmd, env=_job_env(), capture_output=True, text=True)
+        r = subprocess.run(cmd, env=_job_env(), capture_output=True, text=True,
+                           preexec_fn=_die_with_parent(signal.SIGKILL))
         if r.returncode != 0 and not quiet:
             raise EngineError(f"Snakemake failed in {root} (exit {r.returncode}):\n"
                               f"{(r.stdout + r.stderr)[-3000:]}")
@@ -231,18 +266,26 @@ class Engine:
 
     def _watch(self, root: Path, plan: Path, targets, before, describe):
         """Run Snakemake (its output into PLAN_DIR/snakemake-<time>.log) while a bar counts
-        the finished targets, with elapsed time and ETA; logs each case as it finishes."""
+        the finished targets, with elapsed time and ETA; logs each case as it finishes.
+
+        Snakemake ends with this process, however it ends: it stays in this process's group
+        (a signal to the group, such as Ctrl-C at a terminal or a kill of the whole command,
+        reaches it and its local jobs), and it has a parent-death signal (this process killed
+        alone: SIGKILL locally; SIGINT with a batch system, on which Snakemake tries to cancel its
+        submitted jobs). Each job runs under a guard (``--guard``) that ends it when this
+        process has ended."""
         logfile = root / PLAN_DIR / f"snakemake-{time.strftime('%Y%m%d-%H%M%S')}-{os.getpid()}.log"
         seen = set(before)
         t0 = time.monotonic()
         pos = 0
+        death = signal.SIGINT if (self.slurm or self.cluster) else signal.SIGKILL
         with open(logfile, "w") as fh:
-            # a group of its own, so that an interruption reaches Snakemake, its jobs and their
-            # LAMMPS children together, as a Ctrl-C at a terminal does
             proc = subprocess.Popen(self.command(root, plan), env=_job_env(), stdout=fh,
-                                    stderr=subprocess.STDOUT, text=True, start_new_session=True)
+                                    stderr=subprocess.STDOUT, text=True,
+                                    preexec_fn=_die_with_parent(death))
             alive = root / PLAN_DIR / f"engine-{socket.gethostname()}-{proc.pid}"
-            alive.touch()
+            alive.write_text(json.dumps({"owner": os.getpid(),
+                                         "command": " ".join(map(shlex.quote, sys.argv))}))
             try:
                 with logging_redirect_tqdm(), tqdm(total=len(targets), initial=len(before),
                                                    unit="case", desc="study",
@@ -267,15 +310,239 @@ class Engine:
                             alive.unlink(missing_ok=True)
                             return rc, logfile
             except BaseException:
-                # Ctrl-C: Snakemake stops its running jobs (their targets stay missing)
-                if proc.poll() is None:
-                    _signal_group(proc.pid, signal.SIGINT)
-                    try:
-                        proc.wait(timeout=60)
-                    except subprocess.TimeoutExpired:
-                        _signal_group(proc.pid, signal.SIGKILL)
-                        proc.wait()
+                # Ctrl-C at a terminal reached Snakemake and its local jobs with this process;
+                # anything else (a signal to this process alone, an error) is passed on. Its
+                # running jobs stop, their targets stay missing.
+                _stop(proc, local=not (self.slurm or self.cluster))
+                alive.unlink(missing_ok=True)
                 raise
+
+
+def _stop(proc: subprocess.Popen, local: bool):
+    """Stop a Snakemake that this process is leaving. After a Ctrl-C it ends by itself. Else,
+    locally SIGKILL (its jobs end with this process, by their guard; a local Snakemake given
+    SIGINT would wait for them); with a batch system SIGINT, on which it tries to cancel the jobs
+    it submitted; SIGKILL when it has not ended after a while."""
+    steps = ((None, 5), (signal.SIGKILL, None)) if local else \
+        ((None, 10), (signal.SIGINT, 30), (signal.SIGKILL, None))
+    for sig, wait in steps:
+        if proc.poll() is not None:
+            return
+        if sig is not None:
+            proc.send_signal(sig)
+        try:
+            proc.wait(timeout=wait)
+        except subprocess.TimeoutExpired:
+            pass
+
+
+_LIBC = None
+
+
+def _die_with_parent(sig):
+    """A preexec_fn giving the child the parent-death signal sig (Linux prctl
+    PR_SET_PDEATHSIG): it gets sig when this thread ends, even by SIGKILL."""
+    global _LIBC
+    if _LIBC is None:
+        _LIBC = ctypes.CDLL(None, use_errno=True)
+    prctl, parent = _LIBC.prctl, os.getpid()
+
+    def preexec():
+        prctl(1, int(sig), 0, 0, 0)             # PR_SET_PDEATHSIG
+        if os.getppid() != parent:              # the parent died before that
+            os.kill(os.getpid(), sig)
+    return preexec
+
+
+def _start_time(pid: int) -> str | None:
+    """The start time of process pid (field 22 of /proc/PID/stat), None if it is gone or a
+    zombie: with the pid it names one process, even if the pid is reused later."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    fields = stat[stat.rindex(")") + 2:].split()   # after "pid (comm) "
+    return None if fields[0] in "ZX" else fields[19]
+
+
+def _owner() -> str:
+    """This process as the owner of an engine: OWNER_ENV's value."""
+    return f"{socket.gethostname()}:{os.getpid()}:{_start_time(os.getpid())}"
+
+
+def guard(argv: list[str]) -> int:
+    """Run a job's command argv (``python -m granular_charged.studies.engine --guard -- ARGV``)
+    and end it when the study's command (OWNER_ENV) has ended: a job of a killed study does not
+    go on in the background. The job gets SIGKILL if this guard is killed (parent-death
+    signal), and SIGINT/SIGTERM sent to the guard; its output is passed on with every line that
+    is not a case's log line (run.logs.CASE_MARK) indented, so that the engine's own errors
+    stand out in Snakemake's log (engine_error). On another host (a cluster's node) the owner
+    cannot be seen and the job is not watched."""
+    host, _, rest = os.environ.get(OWNER_ENV, "").partition(":")
+    pid, _, born = rest.partition(":")
+    watch = host == socket.gethostname() and pid.isdigit()
+    if watch and _start_time(int(pid)) != born:
+        print(f"the study's command (PID {pid}) has ended: this job does not run",
+              file=sys.stderr)
+        return 1
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            preexec_fn=_die_with_parent(signal.SIGKILL))
+    def forward(sig, _frame):
+        try:
+            proc.send_signal(sig)
+        except OSError:
+            pass
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, forward)
+
+    def copy():
+        from ..run.logs import CASE_MARK
+        for raw in proc.stdout:
+            line = raw.decode(errors="replace")
+            sys.stdout.write(line if line.startswith(CASE_MARK) else "    " + line)
+            sys.stdout.flush()
+    copier = threading.Thread(target=copy, daemon=True)
+    copier.start()
+    while True:
+        try:
+            rc = proc.wait(timeout=GUARD_POLL)
+            break
+        except subprocess.TimeoutExpired:
+            pass
+        if watch and _start_time(int(pid)) != born:
+            proc.kill()
+            proc.wait()
+            print(f"    the study's command (PID {pid}) has ended: this job is stopped",
+                  flush=True)
+            return 1
+    copier.join(timeout=10)
+    return rc if rc >= 0 else 128 - rc
+
+
+def failed_jobs(text: str) -> set[str]:
+    """The targets of the jobs that failed, from Snakemake's log ("Error in rule R:" blocks
+    with their "output: T" line)."""
+    out, inside = set(), False
+    for line in text.splitlines():
+        if line.startswith("Error in rule "):
+            inside = True
+        elif inside and line.strip().startswith("output:"):
+            out.update(line.split(":", 1)[1].replace(",", " ").split())
+        elif inside and not line.startswith(" "):
+            inside = False
+    return out
+
+
+def engine_error(text: str) -> str | None:
+    """The first error of Snakemake itself in its log, one line ("KeyError: 'USER'",
+    "WorkflowError: SLURM job submission failed ..."), None if there is none. The jobs' own
+    output is indented by their guard and a failed job is reported in an "Error in rule"
+    block: neither counts."""
+    lines = text.splitlines()
+    for k, line in enumerate(lines):
+        m = ERROR_LINE.match(line)
+        if not m or line.startswith(JOB_ERRORS):
+            continue
+        if not line[m.end():].strip():
+            # "WorkflowError:" with its message on the next line
+            rest = [ln.strip() for ln in lines[k + 1:k + 4] if ln.strip()]
+            return f"{m.group(1)}: {rest[0]}" if rest else m.group(1)
+        return line.strip()
+    return None
+
+
+# an error line of Snakemake (an exception's name, or "Error"), not indented; those of a job
+ERROR_LINE = re.compile(r"^((?:[A-Za-z_][\w.]*)?(?:Error|Exception))(?::|$)")
+JOB_ERRORS = ("Error in rule ", "Error executing rule ", "MissingOutputException",
+              "IncompleteFilesException")
+
+
+# what an error of Snakemake means and what to do, by a pattern of its first error line
+MEANINGS = (
+    (r"KeyError: '([A-Z_]+)'",
+     "the environment variable {0} is not set and Snakemake needs it (its Slurm submission "
+     "asks sacct and sacctmgr for $USER's accounts): set it (export {0}=$(id -un))"),
+    (r"SLURM job submission failed",
+     "sbatch refused the job: check --account and --partition (sacctmgr show associations "
+     "user=$USER lists yours) and the limits of the partition (sinfo)"),
+    (r"account .* appears to be invalid",
+     "the --account is not one of this user's Slurm accounts: give one that Snakemake lists"),
+    (r"Failed to run (\w+)|(\w+): not found",
+     "a Slurm command is missing on this machine: run the study on a login node of the "
+     "cluster, where sbatch, sacct and sinfo are"),
+)
+
+
+def failure_message(rc: int, error: str | None, not_run: list[str], total: int,
+                    logfile: Path) -> str:
+    """One line: Snakemake's own failure, what it means, what to do."""
+    if error is None:
+        error = (f"killed by signal {-rc}" if rc < 0
+                 else f"exit {rc} without an error message")
+    meaning = "Snakemake stopped on an error of its own, not of a case (its log has the details)"
+    for pattern, text in MEANINGS:
+        m = re.search(pattern, error)
+        if m:
+            meaning = text.format(*(g for g in m.groups() if g))
+            break
+    cases = (f"{len(not_run)} of {total} cases did not run (they did not fail)" if not_run
+             else "every case ran")
+    return (f"the engine (Snakemake) failed: {error}; {cases}. What it means: {meaning}; then "
+            f"run the same command again (Snakemake's log: {logfile})")
+
+
+def live_engines(root: Path) -> list[dict]:
+    """The engines started by studies on this folder that may still be running, each
+    {host, pid, owner (the PID of the command that started it, None if unknown or gone)}:
+    one on another host, or one on this host whose Snakemake process exists (from the
+    engine-<host>-<pid> files; those of engines that are gone are removed)."""
+    host = socket.gethostname()
+    found = []
+    for f in sorted((root / PLAN_DIR).glob("engine-*")):
+        h, _, pid = f.name[len("engine-"):].rpartition("-")
+        try:
+            info = json.loads(f.read_text() or "{}")
+        except (OSError, ValueError):
+            info = {}
+        owner = info.get("owner")
+        if h != host or not pid.isdigit():
+            found.append({"host": h, "pid": pid, "owner": owner})
+            continue
+        try:
+            cmdline = Path(f"/proc/{pid}/cmdline").read_bytes()
+        except OSError:
+            f.unlink(missing_ok=True)
+            continue
+        if b"snakemake" not in cmdline:
+            f.unlink(missing_ok=True)
+            continue
+        if owner is not None and _start_time(int(owner)) is None:
+            owner = None
+        found.append({"host": h, "pid": pid, "owner": owner})
+    return found
+
+
+def locked_message(root: Path, engines: list[dict]) -> str:
+    """Why the folder is locked and how to go on: the running engine (its PID, how to stop
+    it), or a lock nobody holds here."""
+    host = socket.gethostname()
+    for e in engines:
+        if e["host"] != host:
+            return (f"{root}: a study started on host {e['host']} is running on this folder "
+                    f"(its engine, Snakemake, is PID {e['pid']} there); wait for it to end, or "
+                    f"stop it on {e['host']} with `kill {e['owner'] or e['pid']}`. If that "
+                    "host is gone, run the same command again with --unlock")
+    for e in engines:
+        if e["owner"]:
+            return (f"{root}: a study is running on this folder (granular-charged, PID "
+                    f"{e['owner']}; its engine, Snakemake, PID {e['pid']}); wait for it to "
+                    f"end, or stop it and its runs with `kill {e['owner']}`")
+        return (f"{root}: the engine of a study that ended is still running on this folder "
+                f"(Snakemake, PID {e['pid']}); stop it and its runs with `kill {e['pid']}` "
+                f"(if it was started in a process group of its own: `kill -- -{e['pid']}`)")
+    return (f"{root}: Snakemake's lock is on this folder, but no study's engine runs on this "
+            "machine; if none runs on another one either, run the same command again with "
+            "--unlock")
 
 
 def progress(new_done: int, todo: int, total: int, elapsed: float) -> str:
@@ -295,35 +562,11 @@ def _relay(logfile: Path, pos: int) -> int:
     return pos
 
 
-def _signal_group(pid: int, sig):
-    try:
-        os.killpg(pid, sig)
-    except ProcessLookupError:
-        pass
-
-
-def _engines_alive(root: Path) -> bool:
-    """Whether a Snakemake process started by a study on this folder may still be running: one
-    on another host, or one on this host whose process exists (engine-<host>-<pid> files)."""
-    host = socket.gethostname()
-    for f in (root / PLAN_DIR).glob("engine-*"):
-        h, _, pid = f.name[len("engine-"):].rpartition("-")
-        if h != host or not pid.isdigit():
-            return True
-        try:
-            cmdline = Path(f"/proc/{pid}/cmdline").read_bytes()
-        except OSError:
-            f.unlink(missing_ok=True)
-            continue
-        if b"snakemake" in cmdline:
-            return True
-        f.unlink(missing_ok=True)
-    return False
-
-
 def _job_env() -> dict:
-    """The environment of Snakemake and its jobs: this package first on PYTHONPATH."""
+    """The environment of Snakemake and its jobs: this package first on PYTHONPATH, this
+    process as their owner (OWNER_ENV)."""
     env = dict(os.environ)
+    env[OWNER_ENV] = _owner()
     here = str(Path(__file__).resolve().parents[2])
     env["PYTHONPATH"] = os.pathsep.join([here] + [p for p in env.get("PYTHONPATH", "").split(
         os.pathsep) if p and p != here])
@@ -375,3 +618,9 @@ def table2_case(folder: str, formed: str, qs, extra: dict, np_ranks: int, minute
 def _params_dict(p) -> dict:
     from dataclasses import asdict
     return asdict(p)
+
+
+if __name__ == "__main__":
+    if sys.argv[1:2] != ["--guard"] or "--" not in sys.argv[2:3]:
+        sys.exit("usage: python -m granular_charged.studies.engine --guard -- COMMAND ...")
+    sys.exit(guard(sys.argv[3:]))
