@@ -319,11 +319,12 @@ class Engine:
 
 
 def _stop(proc: subprocess.Popen, local: bool):
-    """Stop a Snakemake that this process is leaving. After a Ctrl-C it ends by itself. Else,
-    locally SIGKILL (its jobs end with this process, by their guard; a local Snakemake given
-    SIGINT would wait for them); with a batch system SIGINT, on which it tries to cancel the jobs
-    it submitted; SIGKILL when it has not ended after a while."""
-    steps = ((None, 5), (signal.SIGKILL, None)) if local else \
+    """Stop a Snakemake that this process is leaving. After a Ctrl-C at a terminal it ends by
+    itself within a second. Else, locally SIGKILL (its jobs end with this process, by their
+    guard; a local Snakemake given SIGINT would wait for them, and a job left running would
+    finish a case after the user stopped the study); with a batch system SIGINT, on which it
+    tries to cancel the jobs it submitted; SIGKILL when it has not ended after a while."""
+    steps = ((None, 1), (signal.SIGKILL, None)) if local else \
         ((None, 10), (signal.SIGINT, 30), (signal.SIGKILL, None))
     for sig, wait in steps:
         if proc.poll() is not None:
