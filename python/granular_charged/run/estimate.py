@@ -128,7 +128,7 @@ def barrier(p: DepositionParams, species: list[dict] | None = None) -> dict | No
     if qmean == 0.0 or not rows:
         return None
     # the most strongly repelled kind: largest q/m of the bed's sign
-    qm = max((q / m for q, m in rows if q * qmean > 0), default=0.0)
+    qm = max((abs(q) / m for q, m in rows if q * qmean > 0), default=0.0)
     if qm <= 0:
         return None
     seq_dz = (_x(p, "seq_dz_L", 0.0) or max(7.0 / (L / rp), 0.25)) * L

@@ -136,7 +136,7 @@ def run_status(result: dict) -> dict:
 
 # ---- progress and ETA -------------------------------------------------------------------------
 
-_PROGRESS = re.compile(r"^GC PROGRESS (\d+) / (\d+) particles, step (\d+), elapsed (\S+) s")
+_PROGRESS = re.compile(r"^GC PROGRESS (\d+) / (\d+) particles, step ([^,\s]+), elapsed (\S+) s")
 
 
 def eta_seconds(line: str, plan: dict | None) -> float | None:
@@ -148,7 +148,10 @@ def eta_seconds(line: str, plan: dict | None) -> float | None:
     m = _PROGRESS.match(line)
     if m is None or not plan:
         return None
-    k, step, elapsed = int(m.group(1)), int(m.group(3)), float(m.group(4))
+    try:
+        k, step, elapsed = int(m.group(1)), float(m.group(3)), float(m.group(4))
+    except ValueError:
+        return None
     n_i = plan["n_i"]
     n = min(k, plan["N_dep"])
     inject_end = n * n_i
