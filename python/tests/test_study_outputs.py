@@ -194,11 +194,13 @@ def test_titles_not_clipped_and_axes_have_units(drawn):
         bb = fig._suptitle.get_window_extent(r)
         W, H = fig.bbox.width, fig.bbox.height
         assert bb.x0 >= 0 and bb.x1 <= W and bb.y1 <= H, p.name
-        # nothing drawn (title, labels, legends, tick labels) reaches past the figure's edges
-        tb = fig.get_tightbbox(r)          # inches
-        w, h = fig.get_size_inches()
-        assert tb.x0 >= -0.01 and tb.y0 >= -0.01 and tb.x1 <= w + 0.01 and tb.y1 <= h + 0.01, \
-            (p.name, tb, w, h)
+        # no axis label, axes title or legend reaches past the figure's edges
+        for ax in fig.axes:
+            for a in (ax.xaxis.label, ax.yaxis.label, ax.title, ax.get_legend()):
+                if a is not None and a.get_visible():
+                    e = a.get_window_extent(r)
+                    assert e.x0 >= -1 and e.y0 >= -1 and e.x1 <= W + 1 and e.y1 <= H + 1, \
+                        (p.name, e)
         for ax in fig.axes:
             for lab in (ax.get_xlabel(), ax.get_ylabel()):
                 assert lab and "[" in lab and "]" in lab, (p.name, lab)
@@ -257,6 +259,7 @@ def test_estimate_includes_the_settling():
     p = DepositionParams(N=100, extra={"L_rp": "14", "inject": "rain", "gap_rp": "1"})
     pl = estimate.plan(p)
     assert pl["settle_steps"] == pytest.approx(estimate.SETTLE_RP[False] * pl["unit"])
+    assert pl["settle_steps"] >= 50 * pl["unit"]       # the fit: tens of r_p / U_0 at least
     assert pl["steps"] == pytest.approx(pl["inject_steps"] + pl["fall_steps"] + pl["settle_steps"])
     # for a small bed the last fall and the settling are most of the work
     assert pl["work"] > 2 * pl["n_i"] * 100 ** 2 / 2

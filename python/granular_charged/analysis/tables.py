@@ -81,6 +81,7 @@ def summary(runs: pd.DataFrame) -> pd.DataFrame:
     was too thin for one), the groups, atoms, particles lost, mean wall time, unsettled (runs
     whose bed did not settle); and phi_0/phi - 1
     against the neutral case of the same (r_p, U_0, gamma) (NaN without one)."""
+    runs = runs if "settled" in runs else runs.assign(settled=None)
     s = (runs.groupby(list(CASE), as_index=False)
          .agg(runs=("phi", "count"), no_slab=("phi", lambda v: int(v.isna().sum())),
               phi=("phi", "mean"), phi_sd=("phi", "std"),
