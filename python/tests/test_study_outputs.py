@@ -208,6 +208,18 @@ def test_titles_not_clipped_and_axes_have_units(drawn):
     assert all("q_sigma [C/m^2]" == ax.get_xlabel() for ax in qfig.axes)
 
 
+def test_figures_of_points_without_a_slab(results, tmp_path):
+    """A point whose beds were too thin for the analysis slab (phi, <Z> None) is drawn as a gap,
+    the other figures as usual."""
+    import copy
+    thin = copy.deepcopy(results)
+    for r in thin:
+        if r["params"]["gamma"] == 0.01:
+            r.update(phi=None, Z=None, zlo=None, zhi=None, fZ=[])
+    paths = sf.study_figures(STUDY, thin, tmp_path)
+    assert {"force_pdf.png", "phi_Z_vs_q_sigma.png"} <= {p.name for p in paths}
+
+
 def test_study_label_names_only_what_all_runs_share(results):
     lab = sf.study_label(STUDY, results)
     assert lab.startswith(NAME) and "gamma" not in lab and "area" not in lab and "N = 60" in lab

@@ -78,9 +78,10 @@ def _save(fig, path: Path, data: pd.DataFrame | None, name: str) -> Path:
 
 
 def _mean_sd(vals):
+    """Mean and sd of the finite values (NaN, 0 without any: a bed too thin for the slab)."""
     v = np.array([x for x in vals if x is not None and np.isfinite(x)], dtype=float)
     if not len(v):
-        return np.nan, np.nan
+        return np.nan, 0.0
     return float(v.mean()), float(v.std(ddof=1)) if len(v) > 1 else 0.0
 
 
@@ -211,9 +212,11 @@ def _forces(runs) -> np.ndarray:
     return np.concatenate(vals) if vals else np.zeros(0)
 
 
-def _force_edges(all_vals, bins: int = 60) -> np.ndarray:
-    """Bins symmetric about 0 out to the 99th percentile of |F_n / F_C|."""
+def _force_edges(all_vals) -> np.ndarray:
+    """Bins symmetric about 0 out to the 99th percentile of |F_n / F_C|, about 20 contacts per
+    bin (10 to 60 bins)."""
     v = [x for x in all_vals if len(x)]
+    bins = int(min(60, max(10, min((len(x) for x in v), default=0) // 20)))
     lim = float(np.percentile(np.abs(np.concatenate(v)), 99.0)) if v else 0.2
     return np.linspace(-lim, lim, bins + 1) if lim > 0 else np.linspace(-0.2, 0.2, bins + 1)
 
@@ -278,6 +281,9 @@ def point_figure(d, out: Path, k: int, key: tuple, runs: list[dict], per_species
     a1.set_ylabel("f(Z) [fraction of the slab's particles]")
     if a1.get_legend_handles_labels()[0]:
         a1.legend(fontsize=6)
+    else:
+        a1.text(0.5, 0.5, "no analysis slab (bed too thin)", ha="center", va="center",
+                transform=a1.transAxes, fontsize=7)
     # <Z> per size class of each species (means over the seeds of the classes' radius and <Z>)
     cls = {}
     for r in runs:
@@ -296,7 +302,8 @@ def point_figure(d, out: Path, k: int, key: tuple, runs: list[dict], per_species
     if a2.get_legend_handles_labels()[0]:
         a2.legend(fontsize=6)
     else:
-        a2.text(0.5, 0.5, "one radius: no size classes", ha="center", va="center",
+        a2.text(0.5, 0.5, "no size classes (one radius, or no analysis slab)", ha="center",
+                va="center",
                 transform=a2.transAxes, fontsize=7)
     if len(forces):
         edges = _force_edges([forces])
