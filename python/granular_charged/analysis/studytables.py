@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..run import logs, population
-from . import packing
+from ..params import population_charged
+from . import packing, status
 from .tables import grid_value
 
 log = logging.getLogger(__name__)
@@ -89,21 +89,49 @@ def point_label(names, values) -> str:
     return ", ".join(parts)
 
 
-def charge_label(r: dict, names: dict | None = None) -> str:
-    """The charges of a run, as the run has them: 'uncharged', or per species (named by names,
-    {species number: name}) the rule and its value (e.g. 'area sigma -2e-07 C/m^2')."""
+def deck_vars(r: dict) -> dict:
+    """The deck variables of a result's run {name: text} (its fields and extra)."""
     p = r.get("params") or {}
     v = {k: str(x) for k, x in p.items() if k != "extra"}
     v.update({k: str(x) for k, x in (p.get("extra") or {}).items()})
+    return v
+
+
+def is_population(v: dict) -> bool:
+    """The deck's rule (its variable pop): more than one species, a size or a charge rule."""
+    return (int(float(v.get("species", 1))) != 1 or v.get("r_dist", "one") != "one"
+            or v.get("q_dist", "fixed") != "fixed")
+
+
+def is_charged(v: dict) -> bool:
+    return population_charged(v) if is_population(v) else float(v.get("q", 0)) != 0
+
+
+def charges(v: dict) -> list[dict]:
+    """The charge rule of each species {'dist', 'q', 'sigma', 'sd', 'pos'} from deck variables
+    (species s > 1: name_s, else species 1's value, as the deck reads them)."""
+    out = []
+    for s in range(1, int(float(v.get("species", 1))) + 1):
+        def g(name, default):
+            return v.get(f"{name}_{s}", v.get(name, default)) if s > 1 else v.get(name, default)
+        out.append({"dist": g("q_dist", "fixed"), "q": float(g("q", 0.0)),
+                    "sigma": float(g("q_sigma", 0.0)), "sd": float(g("q_sd", 0.0)),
+                    "pos": float(g("q_pos", 0.5))})
+    return out
+
+
+def charge_label(r: dict, names: dict | None = None) -> str:
+    """The charges of a run, as the run has them: 'uncharged', or per species (named by names,
+    {species number: name}) the rule and its value (e.g. 'area sigma -2e-07 C/m^2')."""
+    v = deck_vars(r)
     try:
-        if not population.is_charged(v):
+        if not is_charged(v):
             return "uncharged"
-        sp = population.describe(v)["species"]
-    except Exception:       # noqa: BLE001 - a label never stops the tables
+        sp = charges(v)
+    except (TypeError, ValueError):     # a label never stops the tables
         return "charged"
     parts = []
-    for s, x in enumerate(sp, start=1):
-        c = x["charge"]
+    for s, c in enumerate(sp, start=1):
         d = c["dist"]
         if d == "fixed":
             txt = f"q {c['q']:g} e0"
@@ -154,7 +182,7 @@ def species_rows(r: dict) -> list[dict]:
 
 
 def _status_cols(r: dict) -> dict:
-    st = logs.run_status(r)
+    st = status.run_status(r)
     return {"made": st["made"], "settled": st["settled"], "complete_deposit": not st["short"],
             "warning": st["warning"] or ""}
 
@@ -182,8 +210,7 @@ def study_tables(d: dict, results: list[dict], out: Path) -> tuple[pd.DataFrame,
         for c in py.get("classes", []):
             cls.append({**base, "species_name": spn.get(int(c["species"]), f"species {c['species']}"),
                         **{k: c[k] for k in ("species", "class", "r_lo", "r_hi", "n", "Z")}})
-        if r.get("dir") and (len(spn) > 1 or population.is_population(
-                {k: str(v) for k, v in (r["params"].get("extra") or {}).items()})):
+        if r.get("dir") and (len(spn) > 1 or is_population(deck_vars(r))):
             try:
                 srows = species_rows(r)
             except (OSError, ValueError, KeyError, IndexError) as e:

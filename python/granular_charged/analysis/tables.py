@@ -7,7 +7,7 @@ import pandas as pd
 
 from .. import paper
 from ..params import MATERIAL, DepositionParams, ParamError
-from ..run.logs import run_status
+from .status import run_status
 
 CASE = ("rp_um", "U0", "gamma_mJ", "q")    # a case of one variant: everything but the seed
 
