@@ -229,6 +229,18 @@ def test_study_label_names_only_what_all_runs_share(results):
     assert "gamma 0.02 J/m^2" in lab and "area sigma -5e-07" in lab
 
 
+def test_covaried_parameters_are_one_axis(results, tmp_path):
+    """Both species' charge densities varied together: phi against q_sigma has one series per
+    gamma (q_sigma_2 is not a series of its own)."""
+    d = dict(STUDY, grid={"gamma": [0.01, 0.02],
+                          "together": {"q_sigma": [0, -5e-7], "q_sigma_2": [0, 5e-7]}})
+    assert studytables.axis_groups(d) == [["gamma"], ["q_sigma", "q_sigma_2"]]
+    sf.study_figures(d, results, tmp_path)
+    t = pd.read_csv(tmp_path / "phi_Z_vs_q_sigma.csv")
+    allp = t[(t["species"] == "all") & (t["measure"] == "phi")]
+    assert "q_sigma_2" not in t.columns and len(allp) == 4 and allp["runs"].eq(2).all()
+
+
 def test_units_of_grid_parameters():
     assert studytables.axis_label("q_sigma") == "q_sigma [C/m^2]"
     assert studytables.axis_label("q_sigma_2") == "q_sigma_2 [C/m^2]"

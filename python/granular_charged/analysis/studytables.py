@@ -63,6 +63,22 @@ def grid_names(d: dict) -> list[str]:
     return names
 
 
+def axis_groups(d: dict) -> list[list[str]]:
+    """The grid's axes as lists of names: the parameters of a co-varied axis together (the
+    study's 'axes' when loaded, else its grid's entries), each other parameter alone."""
+    if d.get("axes"):
+        return [list(a) for a in d["axes"]]
+    out = []
+    for k, v in (d.get("grid") or {}).items():
+        if isinstance(v, dict):
+            out.append(list(v))
+        elif isinstance(v, list) and v and all(isinstance(x, dict) for x in v):
+            out += [list(x) for x in v]
+        else:
+            out.append([k])
+    return out
+
+
 def _num(v):
     try:
         x = float(v)

@@ -2,8 +2,8 @@
 data as CSV beside it (with the study's name in a column `study`):
 
 - phi_Z_vs_<axis>.png per varied parameter: phi and <Z> (mean +- sd over the seeds) against
-  it, one series per value of the other varied parameters; for a mixture also each species'
-  contribution to phi and its <Z>;
+  it, one series per value of the other axes (parameters varied together with it are one
+  axis); for a mixture also each species' contribution to phi and its <Z>;
 - fZ_gr.png: f(Z), g(r) in units of the mean diameter and of r_i + r_j, per grid point (its
   first seed);
 - force_pdf.png: the pdf of the normal contact forces F_n / F_C per grid point (all seeds);
@@ -24,8 +24,8 @@ import numpy as np
 import pandas as pd
 
 from ..analysis import measures, packing
-from ..analysis.studytables import (axis_label, charge_label, fmt, grid_names, point,
-                                    point_label, species_names, species_rows)
+from ..analysis.studytables import (axis_groups, axis_label, charge_label, fmt, grid_names,
+                                    point, point_label, species_names, species_rows)
 from .base import material_label, new_figure
 
 log = logging.getLogger(__name__)
@@ -112,7 +112,10 @@ def _species_of(results) -> dict:
 def vs_axis(d, results, out: Path, axis: str, label: str, per_species: dict) -> Path:
     """phi and <Z> against one varied parameter (module docstring)."""
     names = grid_names(d)
-    others = [n for n in names if n != axis]
+    # the series: the values of the other axes (a parameter varied together with this one is
+    # not another series)
+    same = next((g for g in axis_groups(d) if axis in g), [axis])
+    others = [n for n in names if n not in same]
     spn = species_names(d)
     nsp = max((len(v) for v in per_species.values()), default=0)
     mixture = nsp > 1
