@@ -86,8 +86,9 @@ def test_study_file_grid_seeds_and_protocol_warning(tmp_path, caplog):
     # the figures' title names the study and its material
     fake = [{"params": dict(vars(p), extra=dict(p.extra)), "protocol": "plane"} for p in ps]
     label = study_label(d, fake)
-    assert label.startswith("my dust (rho 3000, E 1e+08, uniform radii, area charges, gamma 0.02")
-    assert "paper" not in label
+    # (the charges differ between the points: each point's figure says its own)
+    assert label.startswith("my dust (rho 3000, E 1e+08, uniform radii, gamma 0.02 J/m^2")
+    assert "paper" not in label and "area" not in label
 
 
 def test_rdf_contact_is_rdf_slab_for_one_size():

@@ -7,6 +7,7 @@ import pandas as pd
 
 from .. import paper
 from ..params import MATERIAL, DepositionParams, ParamError
+from .status import run_status
 
 CASE = ("rp_um", "U0", "gamma_mJ", "q")    # a case of one variant: everything but the seed
 
@@ -50,10 +51,12 @@ def one_variant(results: list[dict], chosen: str | None = None) -> list[dict]:
 
 def runs_frame(results: list[dict]) -> pd.DataFrame:
     """One row per run: parameters, dimensionless groups, phi, <Z> (LAMMPS computes) and the
-    Python cross-check, counters, timing, folder."""
+    Python cross-check, counters (particles made, whether the bed settled: None for a log
+    without the deck's settled field), timing, folder."""
     rows = []
     for r in results:
         p, g = r["params"], r["groups"]
+        st = run_status(r)
         rows.append({
             "rp_um": p["rp"] * 1e6, "U0": p["U0"], "gamma_mJ": p["gamma"] * 1e3, "q": p["q"],
             "seed": p["seed"], "N": p["N"], "Ad": g["Ad"], "Estar": g["Estar"],
@@ -61,9 +64,10 @@ def runs_frame(results: list[dict]) -> pd.DataFrame:
             "phi_python": r.get("python", {}).get("phi"), "Z_python": r.get("python", {}).get("Z"),
             "natoms": r["natoms"], "lost": r["lost"], "flying": r["flying"],
             "wall_s": r.get("wall_s"), "key": r["key"], "dir": r.get("dir"),
+            "made": st["made"], "settled": st["settled"],
         })
     cols = list(CASE) + ["seed", "N", "Ad", "Estar", "Adstar", "phi", "Z", "phi_python", "Z_python",
-                   "natoms", "lost", "flying", "wall_s", "key", "dir"]
+                   "natoms", "lost", "flying", "wall_s", "key", "dir", "made", "settled"]
     df = pd.DataFrame(rows, columns=cols)
     # a run without an analysis slab has phi = <Z> = None: NaN, whatever the other runs have
     for c in ("phi", "Z", "phi_python", "Z_python"):
@@ -74,14 +78,17 @@ def runs_frame(results: list[dict]) -> pd.DataFrame:
 def summary(runs: pd.DataFrame) -> pd.DataFrame:
     """Per case (r_p, U_0, gamma, q): runs (those with an analysis slab, which the means and
     standard deviations of phi and <Z> over the seeds are made of), no_slab (the runs whose bed
-    was too thin for one), the groups, atoms, particles lost, mean wall time; and phi_0/phi - 1
+    was too thin for one), the groups, atoms, particles lost, mean wall time, unsettled (runs
+    whose bed did not settle); and phi_0/phi - 1
     against the neutral case of the same (r_p, U_0, gamma) (NaN without one)."""
+    runs = runs if "settled" in runs else runs.assign(settled=None)
     s = (runs.groupby(list(CASE), as_index=False)
          .agg(runs=("phi", "count"), no_slab=("phi", lambda v: int(v.isna().sum())),
               phi=("phi", "mean"), phi_sd=("phi", "std"),
               Z=("Z", "mean"), Z_sd=("Z", "std"), Ad=("Ad", "first"), Estar=("Estar", "first"),
               Adstar=("Adstar", "first"), N=("natoms", "mean"), lost=("lost", "sum"),
-              wall_s=("wall_s", "mean")))
+              wall_s=("wall_s", "mean"),
+              unsettled=("settled", lambda v: int((v == False).sum()))))  # noqa: E712
     series = ["rp_um", "U0", "gamma_mJ"]
     neutral = s[s["q"] == 0].set_index(series)
     s = s.join(neutral["phi"].rename("phi0"), on=series)

@@ -24,8 +24,10 @@ from ..params import DepositionParams
 PAPER_STYLE = MappingProxyType(dict(color="k", ls=":", lw=1.0))   # read-only
 
 
-def new_figure(w: float, h: float) -> Figure:
-    fig = Figure(figsize=(w, h))
+def new_figure(w: float, h: float, layout: str | None = None) -> Figure:
+    """A figure of w x h inches; layout "constrained": titles, labels and legends fit in it
+    (do not call tight_layout on it)."""
+    fig = Figure(figsize=(w, h), layout=layout)
     FigureCanvasAgg(fig)
     return fig
 
