@@ -30,10 +30,10 @@ from pathlib import Path
 
 from ..analysis import packing
 from ..params import DepositionParams, ParamError, coulomb_to_adhesion
-from . import child, population
+from . import child, estimate, population
 from .deckfile import deck_path, deck_variables
 from .lammps_build import LammpsBuild
-from .logs import read_new_lines
+from .logs import eta_seconds, read_new_lines
 
 log = logging.getLogger(__name__)
 
@@ -357,8 +357,9 @@ class Runner:
 
     # ---- one deck -------------------------------------------------------------------------
     def run_deck(self, deck: str, workdir: Path, variables: dict, kind: str = "none",
-                 render: bool = False) -> dict:
+                 render: bool = False, plan: dict | None = None) -> dict:
         """Run a packaged deck in workdir (created); return lammps.json plus wall/CPU times.
+        plan: a deposition's estimate.run_plan, for the time left its progress bar shows.
         Raises RunError with the tail of the log on failure."""
         workdir = Path(workdir)
         workdir.mkdir(parents=True, exist_ok=True)
@@ -379,7 +380,7 @@ class Runner:
             t0 = time.monotonic()
             ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
             if self.show_progress and kind == "deposition":
-                r = self._watch(cmd, env, workdir, kind)
+                r = self._watch(cmd, env, workdir, kind, plan)
             else:
                 r = subprocess.run(cmd, env=env, capture_output=True, text=True,
                                    timeout=self.timeout)
@@ -410,7 +411,8 @@ class Runner:
         out["cpu_s"] = (ru1.ru_utime - ru0.ru_utime) + (ru1.ru_stime - ru0.ru_stime)
         return out
 
-    def _watch(self, cmd, env, workdir: Path, kind: str) -> subprocess.CompletedProcess:
+    def _watch(self, cmd, env, workdir: Path, kind: str,
+               plan: dict | None = None) -> subprocess.CompletedProcess:
         """Run the child, following the GC PROGRESS lines of its log.lammps (particles made / N)
         with a tqdm bar when self.show_progress (a deposition); the timeout kills it."""
         with tempfile.TemporaryFile("w+") as fo, tempfile.TemporaryFile("w+") as fe:
@@ -418,8 +420,11 @@ class Runner:
             bar = None
             if self.show_progress and kind == "deposition":
                 from tqdm import tqdm
+                # the time left is the plan's (the settling included), not tqdm's own rate
                 bar = tqdm(total=None, unit="particle", desc=Path(workdir).name[:40],
-                           leave=False, dynamic_ncols=True)
+                           leave=False, dynamic_ncols=True,
+                           bar_format="{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} "
+                                      "[{elapsed}{postfix}]")
             logf, pos, t0 = Path(workdir) / "log.lammps", 0, time.monotonic()
             try:
                 while True:
@@ -433,7 +438,7 @@ class Runner:
                         proc.wait()
                         raise subprocess.TimeoutExpired(cmd, self.timeout)
                     if bar is not None:
-                        pos = self._progress(logf, pos, bar)
+                        pos = self._progress(logf, pos, bar, plan)
             except BaseException:
                 if proc.poll() is None:
                     proc.kill()
@@ -447,19 +452,24 @@ class Runner:
             return subprocess.CompletedProcess(cmd, rc, fo.read(), fe.read())
 
     @staticmethod
-    def _progress(logf: Path, pos: int, bar) -> int:
-        """Read log.lammps from byte pos; move the bar to the last GC PROGRESS line's count."""
+    def _progress(logf: Path, pos: int, bar, plan: dict | None = None) -> int:
+        """Read log.lammps from byte pos; move the bar to the last GC PROGRESS line's count,
+        with the time left by the run's plan (eta_seconds: the settling included)."""
         lines, pos = read_new_lines(logf, pos)
         last = settle = None
+        left = None
         for line in lines:
             if line.startswith("GC PROGRESS "):
                 last = parse_progress(line)
+                left = eta_seconds(line, plan)
             elif line.startswith("GC SETTLE "):
                 settle = line.replace(",", " ").split()
         if last is not None:
             bar.total = last["N"]
             bar.n = last["k"]
             post = {"step": last["step"]}
+            if left is not None:
+                post["left"] = f"~{left:.0f} s"
             if last.get("kerel") is not None and last["k"] >= last["N"]:
                 post["settling: kerel"] = f"{last['kerel']:.2g}"
             bar.set_postfix(post, refresh=False)
@@ -531,7 +541,8 @@ class Runner:
         try:
             pieces = self._begin_piece(wd, point, variables)
             lmp = self.run_deck("in.deposition", wd, variables, kind="deposition",
-                                render=self.render and self.build.can_render)
+                                render=self.render and self.build.can_render,
+                                plan=estimate.run_plan(p))
         except RunError as e:
             if point is None or str(e).startswith("no space left"):
                 raise
@@ -547,7 +558,8 @@ class Runner:
             point = None
             pieces = self._begin_piece(wd, None, variables)
             lmp = self.run_deck("in.deposition", wd, variables, kind="deposition",
-                                render=self.render and self.build.can_render)
+                                render=self.render and self.build.can_render,
+                                plan=estimate.run_plan(p))
         pieces[-1].update(wall_s=lmp["wall_s"], cpu_s=lmp["cpu_s"])
         if len(pieces) > 1:
             write_json(wd / PIECES, pieces)

@@ -14,9 +14,8 @@ import logging
 import tomllib
 from pathlib import Path
 
-import pandas as pd
 
-from ..analysis.tables import grid_value
+from ..analysis.studytables import study_tables
 from ..figures.studyfile import study_figures
 from ..params import DepositionParams, ParamError, param_names
 from ..run import population
@@ -167,43 +166,6 @@ def params(d: dict) -> list[DepositionParams]:
     return list({p.key(): p for p in out}.values())
 
 
-def tables(d: dict, results: list[dict], out: Path):
-    """runs.csv, summary.csv (mean +- sd over the seeds per grid point) and classes.csv."""
-    names = list(d.get("grid", {}))
-    rows, cls = [], []
-    for r in results:
-        row = {k: grid_value(r, k) for k in names}
-        row.update(seed=r["params"]["seed"], N=r["params"]["N"], protocol=r.get("protocol"),
-                   phi=r["phi"], Z=r["Z"], phi_python=r["python"]["phi"],
-                   Z_python=r["python"]["Z"], natoms=r["natoms"],
-                   mean_diameter=r["python"].get("mean_diameter"), key=r["key"])
-        rows.append(row)
-        for c in r["python"].get("classes", []):
-            cls.append({**{k: grid_value(r, k) for k in names}, "seed": r["params"]["seed"],
-                        **{k: c[k] for k in ("species", "class", "r_lo", "r_hi", "n", "Z")}})
-    runs = pd.DataFrame(rows)
-    for k in names:                  # numbers as numbers (sorted by value, not as text)
-        try:
-            runs[k] = runs[k].astype(float)
-        except (ValueError, TypeError):
-            pass
-    if names and len(runs):
-        runs = runs.sort_values(names + ["seed"], kind="stable")
-    runs.to_csv(out / "runs.csv", index=False)
-    if names and len(runs):
-        g = runs.groupby(names, dropna=False)
-        summ = g.agg(runs=("seed", "count"), phi=("phi", "mean"), phi_sd=("phi", "std"),
-                     Z=("Z", "mean"), Z_sd=("Z", "std")).reset_index()
-    else:
-        summ = pd.DataFrame([{"runs": len(runs), "phi": runs["phi"].mean() if len(runs) else None,
-                              "phi_sd": runs["phi"].std() if len(runs) else None,
-                              "Z": runs["Z"].mean() if len(runs) else None,
-                              "Z_sd": runs["Z"].std() if len(runs) else None}])
-    summ.to_csv(out / "summary.csv", index=False)
-    pd.DataFrame(cls).to_csv(out / "classes.csv", index=False)
-    return runs, summ
-
-
 def run(path, runner, jobs: int = 1, progress: bool = True, engine=None) -> dict:
     """Run a study file: the runs (resumable), then tables and figures under its out folder."""
     d = load(path)
@@ -215,7 +177,7 @@ def run(path, runner, jobs: int = 1, progress: bool = True, engine=None) -> dict
     announce(ps, out / "runs", d["protocol"])
     results = Sweep(runner, out / "runs", jobs=jobs, progress=progress, engine=engine).run(ps)
     out.mkdir(parents=True, exist_ok=True)
-    runs, summ = tables(d, results, out)
+    runs, summ = study_tables(d, results, out)
     figs = study_figures(d, results, out / "figures") if results else []
     return {"study": d, "results": results, "runs": runs, "summary": summ, "figures": figs,
             "complete": len(results) == len(ps)}
