@@ -14,7 +14,7 @@ import json
 import math
 from pathlib import Path
 
-from ..params import DepositionParams, time_step
+from ..params import DepositionParams, ParamError, time_step
 from . import population
 
 # when no finished run is found: c of the kept runs of this package (neutral, charged) and a
@@ -39,6 +39,8 @@ def interval_steps(p: DepositionParams, dt: float | None = None) -> tuple[str, f
             rmin = min(min(population.bounds(sp["size"])) if sp["size"]["dist"] != "one"
                        else sp["size"]["r"] for sp in population.describe(v)["species"])
         dt = time_step(rmin, p.rho, p.E, p.nu, p.U0, _x(p, "dt_div", 20))
+    if not (isinstance(dt, float) and math.isfinite(dt) and dt > 0):
+        raise ParamError(f"rp = {p.rp:g}: no time step from these parameters (dt = {dt})")
     charged = population.is_charged(v)
     if proto == "rain":
         gap = _x(p, "gap_rp", 0) or (2.0 if charged else 1.0)
@@ -62,12 +64,12 @@ def calibration(folders) -> dict:
                 p = DepositionParams(extra=extra, **prm)
                 cpu = float(r.get("cpu_s") or r["wall_s"])
                 dt = r.get("lammps", {}).get("dt")
-            except (OSError, ValueError, KeyError, TypeError):
-                continue
-            if r.get("key") in seen or not cpu > 0:
+                if r.get("key") in seen or not cpu > 0:
+                    continue
+                _, n = interval_steps(p, float(dt) if dt else None)
+            except (OSError, ValueError, KeyError, TypeError, AttributeError, ArithmeticError):
                 continue
             seen.add(r.get("key"))
-            _, n = interval_steps(p, dt)
             cs[population.is_charged(p.deck_vars())].append(cpu / (p.N ** 2 * n))
     out = {}
     for k, v in cs.items():
