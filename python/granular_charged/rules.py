@@ -402,9 +402,9 @@ def _message(rule_name: str, template: str, vals: Values, item=None) -> str:
             return vals.text.get(m.group(1), "")
         try:
             v = evaluate(m.group(2), vals)
-        except (_NotNumber, ArithmeticError, ValueError):
+        except (_NotNumber, ArithmeticError, ValueError, TypeError):
             return "?"
-        return m.group(3) % v
+        return m.group(3) % v if isinstance(v, (int, float)) else "?"
     text = re.sub(r"\$\{(\w+)\}|\$\((.+?):(%[.\w]+)\)", fill, _expand(template, rule_name))
     return f"{rule_name} = {vals.text.get(rule_name, '')}: {text}"
 
@@ -468,13 +468,15 @@ def problems(given: dict, defaults: dict | None = None, plausible: bool = True,
                 if msg is None:
                     continue
             else:
-                if evaluate(_expand(rule.test, rule.name), vals):
+                try:
+                    fine = evaluate(_expand(rule.test, rule.name), vals)
+                except (ArithmeticError, ValueError, TypeError):
+                    fine = False    # NaN in LAMMPS: every comparison with it is false
+                if fine:
                     continue
                 msg = _message(rule.name, rule.must, vals)
         except _NotNumber as e:
             msg = _not_number(e.name, vals)
-        except (ArithmeticError, ValueError) as e:
-            msg = f"{rule.name} = {vals.text.get(rule.name, '')}: cannot be evaluated ({e})"
         if msg not in out:
             out.append(msg)
         if first:

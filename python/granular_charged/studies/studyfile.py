@@ -47,6 +47,11 @@ def load(path) -> dict:
     d.setdefault("out", str(Path(path).with_suffix("")) + "-output")
     d.setdefault("seeds", [1, 2, 3])
     d.setdefault("protocol", "auto")
+    seeds = d["seeds"]
+    if not (isinstance(seeds, list) and seeds and all(
+            isinstance(s, int) and not isinstance(s, bool) and 1 <= s <= 900000000 for s in seeds)):
+        raise ParamError(f"{path}: seeds = {seeds!r}: must be a list of whole numbers "
+                         "1 .. 900000000, e.g. seeds = [1, 2, 3]")
     if d["protocol"] not in ("auto", "rain", "plane", "sequential"):
         raise ParamError(f"{path}: protocol must be auto, rain, plane or sequential")
     for k, v in d.get("grid", {}).items():
@@ -75,8 +80,8 @@ def params(d: dict) -> list[DepositionParams]:
     fixed = dict(d.get("deck", {}))
     for k in ("rp", "U0", "gamma", "q"):
         if k in fixed:
-            base[k] = float(fixed.pop(k))
-    N = int(fixed.pop("N", d.get("N", 500)))
+            base[k] = fixed.pop(k)
+    N = fixed.pop("N", d.get("N", 500))
     refused = dict(RESERVED, seed="seeds = [...] of the study file")
     grid = d.get("grid", {})
     names = list(grid)
@@ -88,7 +93,7 @@ def params(d: dict) -> list[DepositionParams]:
             pv = dict(popvars)
             for k, v in zip(names, vals):
                 if k in ("U0", "gamma", "q", "rp") and k not in pv:
-                    b[k] = float(v)
+                    b[k] = v
                 elif k in pv or k in param_names():
                     pv[k] = str(v)
                 else:
