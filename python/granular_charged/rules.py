@@ -139,7 +139,7 @@ def _table() -> list:
           W("inject", ("auto", "rain", "plane", "sequential")),
           W("farfield", ("exact", "average", "none")),
           W("coul_extrapolate", YESNO), W("coul_solver", ("replicated", "distributed")),
-          W("electrode", YESNO), W("sleep", YESNO), W("resume", YESNO), W("pair_opt", YESNO),
+          W("electrode", YESNO), W("sleep", YESNO), W("split_log", YESNO), W("resume", YESNO), W("pair_opt", YESNO),
           W("damping_model", ("marshall", "marshall/printed")),
           W("rolling_model", ("marshall", "marshall/particle")),
           N("U0", "v_@ > 0", "finite and > 0 [m/s] (the time step and the injection interval divide by it)"),
@@ -518,6 +518,8 @@ def deck_block() -> str:
            "# \"Input rules\"); exotic yes lets the plausibility rules' values through. A word",
            "# where a number belongs stops it at the first formula that reads it (LAMMPS's",
            "# error 'Variable NAME: Non-numeric variable value').",
+           "# (the block is not echoed to the log)",
+           "echo none",
            f"variable gc_max_redraws equal {MAX_REDRAWS}   # the bound on a lognormal's redraws"]
     for r in RULES:
         if r.kind == "derived":
@@ -569,6 +571,7 @@ def deck_block() -> str:
             out.append(f"label {skip}")
         else:
             out += lines
+    out.append("echo log")
     out.append(END + " ------------------------------------------------")
     return "\n".join(out) + "\n"
 
