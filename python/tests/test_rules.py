@@ -397,3 +397,36 @@ def test_a_study_file_word_or_unit_mistake_is_one_line(tmp_path, line, words):
     r = _gc(["study", f, "--estimate-only"], tmp_path)
     assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
     assert words in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
+
+
+def test_the_decks_redraw_loop_is_bounded(build_dir, tmp_path):
+    """A lognormal radius is drawn again outside its clip range at most gc_max_redraws times
+    per particle, then the deck stops with an error (the rules keep the clip range's mass at
+    least MIN_LOGNORMAL_MASS, so with 20000 this does not happen; here the bound is 1)."""
+    deck = tmp_path / "in.deposition"
+    text = DECK.read_text()
+    line = f"variable gc_max_redraws equal {rules.MAX_REDRAWS}"
+    assert line in text
+    deck.write_text(text.replace(line, "variable gc_max_redraws equal 1"))
+    v = {"N": "20", "L_rp": "8", "H_rp": "12", "r_dist": "lognormal", "rp_gsd": "1.5",
+         "rp_lo": "1.9e-6", "rp_hi": "2.1e-6", "settle_max": "5", "computes": "0"}
+    cmd = [str(Path(build_dir) / "lmp"), "-in", str(deck), "-screen", "none", "-log", "q.log"]
+    for k, x in v.items():
+        cmd += ["-var", k, x]
+    r = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    log = (tmp_path / "q.log").read_text()
+    assert r.returncode == 1 and "GC RESULT" not in log
+    assert "no radius inside its clip range after 1 draws" in log
+
+
+def test_the_estimate_skips_a_finished_run_it_cannot_use(tmp_path):
+    """A result.json whose time step is 0 (or missing numbers) is left out of the calibration,
+    not a ZeroDivisionError."""
+    d = tmp_path / "run"
+    d.mkdir()
+    (d / "result.json").write_text(json.dumps({
+        "key": "k", "params": {"rp": 2e-6, "U0": 1.0, "gamma": 0.01, "q": 0.0, "N": 5,
+                               "seed": 1, "extra": {}},
+        "cpu_s": 10.0, "lammps": {"dt": 0}}))
+    cal = estimate.calibration([tmp_path])
+    assert cal[False][2] == 0
