@@ -114,8 +114,13 @@ def reference_radius(size: dict) -> float:
         return size["median"]
     if d == "uniform":
         return 0.5 * (size["lo"] + size["hi"])
-    f = size.get("fractions") or [1.0] * len(size["radii"])
-    return sum(r * w for r, w in zip(size["radii"], f)) / sum(f)
+    radii = size["radii"]
+    f = size.get("fractions") or [1.0] * len(radii)
+    if not radii:
+        return 0.0                  # refused by the rules (no radius)
+    if len(f) != len(radii) or sum(f) <= 0:
+        f = [1.0] * len(radii)      # fractions the rules refuse: the plain mean meanwhile
+    return sum(r * w for r, w in zip(radii, f)) / sum(f)
 
 
 def _num(v) -> str:
