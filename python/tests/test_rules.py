@@ -206,3 +206,12 @@ def test_the_estimate_skips_a_finished_run_it_cannot_use(tmp_path):
         "cpu_s": 10.0, "lammps": {"dt": 0}}))
     cal = estimate.calibration([tmp_path])
     assert cal[False][2] == 0
+
+
+def test_every_deck_input_has_a_rule():
+    """Each `variable NAME index` input of the deck is checked by a rule (out and log_file,
+    file names, take any word)."""
+    from granular_charged.run.deckfile import deck_variables
+    ruled = {r.name for r in RULES}
+    missing = sorted(set(deck_variables("in.deposition")) - ruled - {"out", "log_file"})
+    assert not missing, f"deck inputs without a rule in granular_charged/rules.py: {missing}"
