@@ -4,8 +4,9 @@ generated into the deck's checking block (the deck refuses the same values when 
 Each rule names a deck variable, a test and what the variable must be. Tests are written in
 LAMMPS's own formula syntax (equal-style, ``v_NAME`` for a variable's value); a rule's gate, when
 it has one, in the syntax of LAMMPS's ``if`` command (``${NAME}`` a number, ``x${NAME} == xword``
-a word). Python evaluates both by translating them (``_py``); the deck gets them as they are
-(``deck_block``). ``{s}`` stands for a species' suffix: "" for species 1, "_2", "_3".
+a word); ``@`` in a test or a message stands for the rule's own variable. Python evaluates
+both by translating them (``_py_formula``, ``_py_gate``); the deck gets them as they are
+(``deck_block``). The rules of species s > 1 are those of species 1 with the suffix _s.
 
 A failed rule is one line, ``NAME = VALUE: what it must be``; the deck prints it as
 ``GC ERROR: NAME = VALUE: ...`` and quits with status 1. A word where a number belongs stops the
@@ -21,7 +22,8 @@ lets such a value through.
 params.check_deck_values raises the first failed rule as a ParamError.
 
 ``python -m granular_charged.rules --write`` writes the block into the packaged deck;
-``--check`` exits 1 when the deck's block differs from the table (a test runs it).
+``--check`` exits 1 when the deck's block differs from the table (python/tests/test_rules.py
+checks the same).
 """
 from __future__ import annotations
 
@@ -47,7 +49,7 @@ def suffix(s: int) -> str:
 
 @dataclass(frozen=True)
 class Rule:
-    """name: the deck variable ({s}: per species); kind: number | word | list | derived;
+    """name: the deck variable; kind: number | word | list | derived;
     test: a formula that is nonzero when the value is fine (number, derived: the value), the
     allowed words (word), or the test of each item (list: v_ITEM); must: the message after
     'NAME = VALUE: ' (${NAME} and $(FORMULA:%.3g) are filled in); when: an if-boolean gate;
@@ -62,10 +64,6 @@ class Rule:
     n: tuple = (1, MAX_RADII)
     zero_default: bool = False
     same_len: str = ""
-
-    @property
-    def per_species(self) -> bool:
-        return "{s}" in self.name
 
 
 def N(name, test, must, raw=False, **kw):
@@ -541,24 +539,24 @@ def deck_block() -> str:
         else:
             item = f"{r.name}_item"
             test = r.test.replace("v_@", f"v_{item}")
-            lines += [f"variable gc_n equal 0",
-                      f"variable gc_bad equal 0",
-                      f"variable gc_zero equal 0",
+            lines += ["variable gc_n equal 0",
+                      "variable gc_bad equal 0",
+                      "variable gc_zero equal 0",
                       f"variable _gcw index ${{{r.name}}}",
                       f"label {skip}_loop",
                       f"  variable {item} string ${{_gcw}}",
-                      f"  variable gc_n equal $(v_gc_n+1)",
+                      "  variable gc_n equal $(v_gc_n+1)",
                       f"  variable gc_bad equal $(v_gc_bad+(({test})==0))",
                       f"  variable gc_zero equal $(v_{item}==0)",
-                      f"  next _gcw",
+                      "  next _gcw",
                       f"jump SELF {skip}_loop"]
             n_ok = f"${{gc_n}} >= {r.n[0]} && ${{gc_n}} <= {r.n[1]}"
             if r.same_len:
-                lines += [f"variable gc_m equal 0",
+                lines += ["variable gc_m equal 0",
                           f"variable _gcw index ${{{r.same_len}}}",
                           f"label {skip}_count",
-                          f"  variable gc_m equal $(v_gc_m+1)",
-                          f"  next _gcw",
+                          "  variable gc_m equal $(v_gc_m+1)",
+                          "  next _gcw",
                           f"jump SELF {skip}_count"]
                 n_ok = "${gc_n} == ${gc_m}"
             ok = f"(${{gc_bad}} == 0 && {n_ok})"
