@@ -31,22 +31,6 @@ MATERIAL = ("farfield", "rho", "E", "nu", "e", "mu", "theta_crit")
 
 
 FARFIELDS = ("exact", "average", "none")
-# deck variables of in.deposition with a range the deck does not check itself: (test, what);
-# every other numeric value must be finite
-DECK_RANGES = {
-    "eps_p": (lambda x: x == 0 or x >= 1, "0 (not polarisable) or a relative permittivity >= 1"),
-    "L_rp": (lambda x: x > 0, "> 0 (the box side in r_p)"),
-    "H_rp": (lambda x: x > 0, "> 0 (the injection height in r_p)"),
-    "gap_rp": (lambda x: x >= 0, ">= 0 (0: the deck's interval)"),
-    "seq_gap_rp": (lambda x: x >= 0, ">= 0 (0: the deck's interval)"),
-    "dt_div": (lambda x: x > 0, "> 0"),
-    "accuracy": (lambda x: x > 0, "> 0"),
-    "ke_stop": (lambda x: x >= 0, ">= 0 (0: settle for settle_max)"),
-    "E0": (lambda x: True, "a field [V/m]"),
-}
-DECK_WORDS = {"pair_opt": ("yes", "no"), "inject": ("auto", "rain", "plane", "sequential"),
-              "electrode": ("yes", "no"), "sleep": ("yes", "no"),
-              "coul_extrapolate": ("yes", "no")}
 
 
 def _finite(x) -> bool:
@@ -56,24 +40,19 @@ def _finite(x) -> bool:
         return False
 
 
+def check_deck_values(values: dict, plausible: bool = True):
+    """ParamError with the first rule of in.deposition that deck variables `values` break (the
+    others at the deck's defaults; granular_charged.rules has the rules, the same the deck
+    checks itself); plausible False leaves out the plausibility rules."""
+    from . import rules
+    found = rules.problems(values, plausible=plausible)
+    if found:
+        raise ParamError(found[0])
+
+
 def check_deck_value(name: str, value):
-    """ParamError when a value of deck variable `name` is one the deck would use without a
-    word though it means nothing (nan, inf, out of its range, a word it does not know)."""
-    text = str(value).strip()
-    if name in DECK_WORDS:
-        if text not in DECK_WORDS[name]:
-            raise ParamError(f"{name} = {text}: must be one of {', '.join(DECK_WORDS[name])}")
-        return
-    try:
-        x = float(text)
-    except ValueError:
-        if name in DECK_RANGES:
-            raise ParamError(f"{name} = {text}: not a number") from None
-        return                      # a word the deck takes (a spec, a solver name)
-    if not math.isfinite(x):
-        raise ParamError(f"{name} = {text}: must be a finite number")
-    if name in DECK_RANGES and not DECK_RANGES[name][0](x):
-        raise ParamError(f"{name} = {text}: must be {DECK_RANGES[name][1]}")
+    """ParamError when deck variable `name` = value breaks a rule of in.deposition."""
+    check_deck_values({name: value})
 
 
 def same_value(a, b) -> bool:
@@ -109,33 +88,21 @@ class DepositionParams:
         if own:
             raise ParamError(f"{', '.join(own)}: a parameter of its own "
                              f"(DepositionParams({own[0]}=...)), not an extra deck variable")
-        # what the deck's arithmetic and LAMMPS's random seeds need, and the values the deck
-        # or a style would take without a word (eps_p < 1 runs without dipoles, a far field
-        # it does not know runs as none, a nan rolling limit never rolls)
-        fin = _finite
-        checks = (("N", self.N, self.N >= 1 and self.N == int(self.N), "a whole number >= 1"),
-                  ("seed", self.seed, self.seed >= 1 and self.seed == int(self.seed),
-                   "a whole number >= 1 (LAMMPS's random seeds are positive)"),
-                  ("rp", self.rp, fin(self.rp) and self.rp > 0, "finite and > 0 [m]"),
-                  ("U0", self.U0, fin(self.U0) and self.U0 > 0,
-                   "finite and > 0 [m/s] (the time step and the injection interval divide by it)"),
-                  ("gamma", self.gamma, fin(self.gamma) and self.gamma >= 0,
-                   "finite and >= 0 [J/m^2]"),
-                  ("rho", self.rho, fin(self.rho) and self.rho > 0, "finite and > 0 [kg/m^3]"),
-                  ("E", self.E, fin(self.E) and self.E > 0, "finite and > 0 [Pa]"),
-                  ("nu", self.nu, fin(self.nu) and -1 < self.nu < 0.5, "between -1 and 0.5"),
-                  ("e", self.e, fin(self.e) and 0 < self.e <= 1, "in (0, 1]"),
-                  ("mu", self.mu, fin(self.mu) and self.mu >= 0, "finite and >= 0"),
-                  ("theta_crit", self.theta_crit, fin(self.theta_crit) and self.theta_crit > 0,
-                   "finite and > 0 [rad]"),
-                  ("q", self.q, fin(self.q), "a finite number [e0]"))
-        for name, value, ok, what in checks:
-            if not ok:
-                raise ParamError(f"{name} = {value:g}: must be {what}")
-        if self.farfield not in FARFIELDS:
-            raise ParamError(f"farfield = {self.farfield}: must be one of {', '.join(FARFIELDS)}")
-        for name, value in self.extra.items():
-            check_deck_value(name, value)
+        # every deck variable, the given ones over the deck's defaults, against the deck's
+        # rules (granular_charged.rules: the same rules the deck checks itself)
+        def text(v):                # a float as short as it is exact: 0 and 2e-06, not 0.0
+            if isinstance(v, float):
+                g = f"{v:g}"
+                return g if float(g) == v else repr(v)
+            return v
+        check_deck_values({k: text(v) for k, v in asdict(self).items() if k != "extra"}
+                          | dict(self.extra))
+        for f in fields(self):
+            if f.name == "extra":
+                continue
+            kind = type(f.default)
+            value = getattr(self, f.name)
+            setattr(self, f.name, int(float(value)) if kind is int else kind(value))
 
     def deck_vars(self) -> dict:
         d = asdict(self)

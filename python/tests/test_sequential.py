@@ -71,7 +71,9 @@ def test_plane_rain_start_plane_follows_the_resting_bed(cli, tmp_path):
     rp = 2.0e-6
     res, log = _run(cli, tmp_path, 400, size=[
         "--N", 40, "--seed", 1, "--var", "L_rp", 28, "--var", "inject", "sequential",
-        "--var", "seq_dz_L", 0.25, "--var", "seq_gap_rp", 4, "--no-render"])
+        "--var", "seq_dz_L", 0.25, "--var", "seq_gap_rp", 4, "--no-render",
+        # the loop's commands echoed (in log.inject.lammps): the start heights are read there
+        "--var", "split_log", "yes", "--var", "log_file", "log.lammps"])
     assert res["inserted"] == 40 and res["flying"] == 0
     starts = [float(h) for h in re.findall(r"^\s*variable\s+h equal ([0-9.eE+-]+)\s*$", log, re.M)]
     assert len(starts) == 40

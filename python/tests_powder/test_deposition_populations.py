@@ -24,7 +24,7 @@ def lognormal_gauss_run(build_dir, tmp_path_factory):
     text = lmp_run(build_dir, DECK, d, {
         "N": 120, "L_rp": 10, "r_dist": "lognormal", "rp_gsd": 1.25, "rp_lo": 1.0e-6,
         "rp_hi": 4.0e-6, "q_dist": "gauss", "q": 100, "q_sd": 30, "inject": "plane",
-        "settle_max": 100, "zlo_rp": 2, "top_rp": 3})
+        "settle_max": 100, "zlo_rp": 2, "top_rp": 3, "split_log": "yes"})
     return d, text
 
 
@@ -53,6 +53,7 @@ def test_deck_draws_follow_the_requested_distributions(lognormal_gauss_run):
     assert abs(q.std(ddof=1) - 30) < 4 * 30 / math.sqrt(2 * n)
     # the run says and records its protocol, keeps log.lammps small and reports progress
     assert "GC PROTOCOL inject plane" in text
+    # (split_log yes: the loop's runs in log.inject.lammps, the log goes on in log.lammps)
     assert text.count("Loop time") <= 4, "log.lammps holds the one-by-one loop's runs"
     prog = [ln for ln in text.splitlines() if ln.startswith("GC PROGRESS")]
     assert len(prog) >= 10 and prog[-1].startswith("GC PROGRESS 120 / 120")

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 
-from ..params import E0, DepositionParams, ParamError, population_charged
+from ..params import E0, DepositionParams, ParamError, check_deck_values, population_charged
 
 SIZE_KEYS = {"one": ("r",), "uniform": ("lo", "hi"), "lognormal": ("median", "gsd", "lo", "hi"),
              "discrete": ("radii", "fractions")}
@@ -43,7 +43,7 @@ def parse_spec(text: str | dict, kinds: dict, what: str) -> dict:
             if "=" not in w:
                 raise ParamError(f"{what} {text!r}: {w!r} is not KEY=VALUE")
             k, v = w.split("=", 1)
-            spec[k] = [float(x) for x in v.split(",")] if k in ("radii", "fractions") else v
+            spec[k] = v
     dist = spec.get("dist")
     if dist not in kinds:
         raise ParamError(f"{what}: {dist!r} is not one of {', '.join(kinds)}")
@@ -54,35 +54,41 @@ def parse_spec(text: str | dict, kinds: dict, what: str) -> dict:
         if k not in kinds[dist]:
             raise ParamError(f"{what} {dist}: no parameter {k!r} (it takes {', '.join(kinds[dist])})")
         try:
-            out[k] = [float(x) for x in v] if k in ("radii", "fractions") else float(v)
+            if k in ("radii", "fractions"):
+                items = v.replace(",", " ").split() if isinstance(v, str) else list(v)
+                out[k] = [float(x) for x in items]
+            else:
+                out[k] = float(v)
         except (TypeError, ValueError):
             raise ParamError(f"{what} {dist}: {k} = {v!r} is not a number") from None
     _check(out, what)
     return out
 
 
+# the keys a spec must give (the rest have the deck's defaults); the values' rules are the
+# deck's (granular_charged.rules), checked on the deck variables the spec becomes
+REQUIRED = {"uniform": ("lo", "hi"), "lognormal": ("median", "gsd"), "discrete": ("radii",),
+            "area": ("sigma",), "gauss": ("sd",)}
+
+
 def _check(s: dict, what: str):
-    d = s["dist"]
-    if d == "uniform" and not (0 < s.get("lo", -1) < s.get("hi", -1)):
-        raise ParamError(f"{what} uniform needs 0 < lo < hi [m]")
-    if d == "lognormal":
-        if s.get("median", 0) <= 0 or s.get("gsd", 0) <= 1:
-            raise ParamError(f"{what} lognormal needs median > 0 [m] and gsd > 1")
-        lo, hi = bounds(s)
-        if not (0 < lo < s["median"] < hi):
-            raise ParamError(f"{what} lognormal needs 0 < lo < median < hi")
-    if d == "discrete":
-        r = s.get("radii") or []
-        f = s.get("fractions") or [1.0] * len(r)
-        if not r or len(r) > MAX_RADII or len(f) != len(r) or min(r) <= 0 or min(f) <= 0:
-            raise ParamError(f"{what} discrete needs 1-{MAX_RADII} radii > 0 and as many "
-                             "fractions > 0")
-    if d == "area" and "sigma" not in s:
-        raise ParamError(f"{what} area needs sigma [C/m^2]")
-    if d == "bipolar" and not (0 <= s.get("pos", 0.5) <= 1):
-        raise ParamError(f"{what} bipolar: pos is a fraction in [0, 1]")
-    if d == "gauss" and s.get("sd", 0) < 0:
-        raise ParamError(f"{what} gauss: sd >= 0")
+    missing = [k for k in REQUIRED.get(s["dist"], ()) if k not in s]
+    if missing:
+        raise ParamError(f"{what} {s['dist']} needs {' and '.join(f'{k}=' for k in missing)}")
+    if s["dist"] in ("one", "uniform", "lognormal", "discrete"):
+        size, charge = (s if s["dist"] != "one" else {**s, "r": s.get("r", DepositionParams.rp)}), None
+    else:
+        size, charge = {"dist": "one", "r": DepositionParams.rp}, s
+    check_vars(species_vars(1, size, charge), what)
+
+
+def check_vars(v: dict, what: str = ""):
+    """ParamError when deck variables v break a rule of the deck (granular_charged.rules; the
+    plausibility rules are left to the run's parameters, where exotic yes can pass them)."""
+    try:
+        check_deck_values(v, plausible=False)
+    except ParamError as e:
+        raise ParamError(f"{what}: {e}" if what else str(e)) from None
 
 
 def bounds(size: dict) -> tuple[float, float]:
@@ -108,8 +114,13 @@ def reference_radius(size: dict) -> float:
         return size["median"]
     if d == "uniform":
         return 0.5 * (size["lo"] + size["hi"])
-    f = size.get("fractions") or [1.0] * len(size["radii"])
-    return sum(r * w for r, w in zip(size["radii"], f)) / sum(f)
+    radii = size["radii"]
+    f = size.get("fractions") or [1.0] * len(radii)
+    if not radii:
+        return 0.0                  # refused by the rules (no radius)
+    if len(f) != len(radii) or sum(f) <= 0:
+        f = [1.0] * len(radii)      # fractions the rules refuse: the plain mean meanwhile
+    return sum(r * w for r, w in zip(radii, f)) / sum(f)
 
 
 def _num(v) -> str:
@@ -151,7 +162,10 @@ def species_vars(s: int, size: dict, charge: dict | None, material: dict | None 
         if k not in MATERIAL_KEYS:
             raise ParamError(f"species {s}: material has no {k!r} (it takes "
                              f"{', '.join(MATERIAL_KEYS)})")
-        v[k + suf] = _num(float(val))
+        try:
+            v[k + suf] = _num(float(val))
+        except (TypeError, ValueError):
+            raise ParamError(f"species {s}: material {k} = {val!r} is not a number") from None
     if fraction is not None and s > 1 or (fraction is not None and fraction != 1.0):
         v["frac" + suf] = _num(fraction)
     return v
@@ -172,8 +186,13 @@ def mixture_vars(species: list[dict]) -> dict:
         if size["dist"] == "one" and "r" not in size:
             raise ParamError(f"species {s} size one needs r=RADIUS")
         charge = parse_spec(sp["charge"], CHARGE_KEYS, f"species {s} charge") if "charge" in sp else None
-        v.update(species_vars(s, size, charge, sp.get("material"),
-                              float(sp.get("fraction", 1.0)) if len(species) > 1 else None))
+        try:
+            fraction = float(sp.get("fraction", 1.0)) if len(species) > 1 else None
+        except (TypeError, ValueError):
+            raise ParamError(f"species {s}: fraction = {sp.get('fraction')!r} is not a "
+                             "number") from None
+        v.update(species_vars(s, size, charge, sp.get("material"), fraction))
+    check_vars(v)
     return v
 
 

@@ -52,9 +52,9 @@ def load(path) -> dict:
         raise ParamError(f"{path}: protocol must be auto, rain, plane or sequential")
     seeds = d["seeds"]
     if not (isinstance(seeds, list) and seeds and all(
-            isinstance(s, int) and not isinstance(s, bool) and s >= 1 for s in seeds)):
-        raise ParamError(f"{path}: seeds = {seeds!r}: must be a non-empty list of whole numbers "
-                         ">= 1, e.g. seeds = [1, 2, 3]")
+            isinstance(s, int) and not isinstance(s, bool) and 1 <= s <= 900000000 for s in seeds)):
+        raise ParamError(f"{path}: seeds = {seeds!r}: must be a list of whole numbers "
+                         "1 .. 900000000, e.g. seeds = [1, 2, 3]")
     d["axes"] = grid_axes(d.get("grid", {}), path)
     # every varied variable with its values, in the file's order (the tables' and figures' axes)
     d["grid"] = {k: v for axis in d["axes"] for k, v in axis.items()}
