@@ -91,15 +91,19 @@ def test_a_negative_area_charge_through_a_study(cli, tmp_path):
 
 
 def test_a_lammps_error_is_one_line(cli, tmp_path):
-    """A value that LAMMPS refuses (a word where its if command needs a number): one line with
-    LAMMPS's ERROR, the deck line and the run folder; the traceback only with -v."""
-    args = ["run", "--out", tmp_path / "runs", "--seed", 1, *SMALL, "--var", "dump_every", "abc"]
+    """A value that passes the deck's rules but that LAMMPS refuses (fix coul/fmm: an accuracy
+    finer than its solver reaches): one line with LAMMPS's ERROR, the deck line and the run
+    folder; the traceback only with -v."""
+    args = ["run", "--out", tmp_path / "runs", "--seed", 1, *SMALL, "--q", 100,
+            "--var", "accuracy", "1e-16"]
     r = cli(args, tmp_path, check=False)
     assert r.returncode == 1
     lines = [ln for ln in r.stderr.splitlines() if "ERROR" in ln]
     assert len(lines) == 1, r.stderr
-    assert "LAMMPS stopped the run in" in lines[0] and "ERROR: If command boolean" in lines[0]
-    assert re.search(r'; in.deposition line \d+: if "\$\{dump_every\} > 0" then', lines[0]), lines[0]
+    assert "LAMMPS stopped the run in" in lines[0] and "ERROR: Fix coul/fmm" in lines[0]
+    assert "is finer than the solver reaches" in lines[0]
+    # LAMMPS checks the accuracy when the fix is initialised, at the deck's first run command
+    assert re.search(r"; (in.deposition line \d+|deck line): run 0", lines[0]), lines[0]
     assert str(tmp_path / "runs") in lines[0]
     assert "Traceback" not in r.stderr
     v = cli(["-v"] + args, tmp_path, check=False)
@@ -109,10 +113,25 @@ def test_a_lammps_error_is_one_line(cli, tmp_path):
 def test_the_runner_says_a_lammps_error_in_one_line(build_dir, tmp_path):
     """The same through the runner (the engine's job writes its message into failed.txt)."""
     runner = Runner(LammpsBuild.find(str(build_dir)), render=False)
-    variables = DepositionParams(N=12, seed=1, extra={"L_rp": "5", "H_rp": "30"}).deck_vars()
-    variables.update(out=".", dump_every="abc")
+    variables = DepositionParams(N=12, seed=1, q=100.0,
+                                 extra={"L_rp": "5", "H_rp": "30"}).deck_vars()
+    variables.update(out=".", accuracy="1e-16")
     with pytest.raises(RunError) as e:
         runner.run_deck("in.deposition", tmp_path / "wd", variables, kind="deposition")
     msg = str(e.value)
-    assert "\n" not in msg and "ERROR: If command boolean" in msg
-    assert re.search(r"in.deposition line \d+: if", msg), msg
+    assert "\n" not in msg and "ERROR: Fix coul/fmm" in msg
+    assert re.search(r"(in.deposition line \d+|deck line): run 0", msg), msg
+
+
+def test_an_unsettled_run_says_so(cli, tmp_path):
+    """A run whose settling is cut short (settle_max 1 r_p/U_0, far below the settling the stop
+    rule needs) ends unsettled: result.json says settled false with a warning, and `run` says
+    it; the same run with the default settle_max settles."""
+    short = cli(["run", "--out", tmp_path / "runs", "--seed", 1, *SMALL, "--var", "settle_max", 1],
+                tmp_path)
+    res = json.loads(Path(short.stdout.strip().splitlines()[-1]).read_text())
+    assert res["settled"] is False and res["deposited"] == 12
+    assert "ended unsettled" in res["warning"] and "ended unsettled" in short.stderr
+    full = cli(["run", "--out", tmp_path / "runs", "--seed", 1, *SMALL], tmp_path)
+    res = json.loads(Path(full.stdout.strip().splitlines()[-1]).read_text())
+    assert res["settled"] is True and "ended unsettled" not in res.get("warning", "")

