@@ -243,7 +243,7 @@ def test_a_word_where_a_number_belongs_is_one_line(tmp_path, change, message):
 
 # ---- LAMMPS's error in one line ------------------------------------------------------------
 
-LOG = """LAMMPS (2 Aug 2023)
+LOG = """LAMMPS (development)
 variable a equal 1
 if "${a} == yes" then "print x"
 ERROR: If command boolean cannot be evaluated (src/input.cpp:1010)
@@ -262,7 +262,7 @@ def test_a_lammps_error_is_one_line(tmp_path):
     assert "ERROR: If command boolean cannot be evaluated" in msg
     assert 'deck line: if "1 == yes" then "print x"' in msg and str(tmp_path) in msg
     # only the child's exception (an error of one rank is not in the log)
-    msg = lammps_error("LAMMPS (2 Aug 2023)\n", TRACEBACK.replace("ERROR:", "ERROR on proc 0:"),
+    msg = lammps_error("LAMMPS (development)\n", TRACEBACK.replace("ERROR:", "ERROR on proc 0:"),
                        tmp_path, 1)
     assert "ERROR on proc 0: If command boolean" in msg and "\n" not in msg
     # the deck's own check

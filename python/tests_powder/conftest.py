@@ -1,4 +1,4 @@
-"""The LAMMPS build for the population depositions (ctest python.populations): the build_dir
+"""The LAMMPS build for the population depositions (ctest python.powder): the build_dir
 fixture of python/tests/lammps_runs.py."""
 import sys
 from pathlib import Path

@@ -1,4 +1,4 @@
-"""Depositions of in.deposition with particle populations (ctest python.populations; a few
+"""Depositions of in.deposition with particle populations (ctest python.powder; a few
 minutes): the drawn radii and charges against their distributions, the computes against the
 Python analysis on a polydisperse packing, a mixture of two species, a bipolar powder's charge
 and Coulomb forces against a direct sum, and a narrow size spread against one size.

@@ -1,4 +1,4 @@
-"""The input rules through lmp (ctest python.populations): every rule of
+"""The input rules through lmp (ctest python.powder): every rule of
 granular_charged/rules.py broken once at the deck's start (status 1, one error line naming the
 variable, the message Python gives word for word, no GC RESULT), the draws of valid size specs,
 the bounded redraws, the log a charged run keeps and the end of an unsettled run. Each rule case

@@ -121,11 +121,10 @@ bool CoulFMMNearRefresh::charged(int i) const
   return (atom->mask[i] & fix->groupbit) && atom->q[i] != 0.0;
 }
 
-// the list's pairs of charged atoms of the group, in its order: visit(i, j, now, then) with the
-// separation now and at the evaluation (from the displacements), then done_with(i) after the
-// pairs of each charged i
+// the list's pairs of charged atoms of the group, in its order: visit(i, j, now) with their
+// separation now, then done_with(i) after the pairs of each charged i
 template <typename Visit, typename DoneWith>
-void CoulFMMNearRefresh::for_each_charged_pair(Visit &&visit, DoneWith &&done_with) const
+void CoulFMMNearRefresh::for_each_charged_separation(Visit &&visit, DoneWith &&done_with) const
 {
   double **x = atom->x;
   for (int ii = 0; ii < list->inum; ii++) {
@@ -134,13 +133,26 @@ void CoulFMMNearRefresh::for_each_charged_pair(Visit &&visit, DoneWith &&done_wi
     for (int jj = 0; jj < list->numneigh[i]; jj++) {
       const int j = list->firstneigh[i][jj] & NEIGHMASK;
       if (!charged(j)) continue;
-      double now[3], then[3];
+      double now[3];
       for (int k = 0; k < 3; k++) now[k] = x[i][k] - x[j][k];
-      MTS::separation_then(now, delta[i], delta[j], then);
-      visit(i, j, now, then);
+      visit(i, j, now);
     }
     done_with(i);
   }
+}
+
+// as for_each_charged_separation, with the separation at the evaluation too (from the
+// displacements): visit(i, j, now, then)
+template <typename Visit, typename DoneWith>
+void CoulFMMNearRefresh::for_each_charged_pair(Visit &&visit, DoneWith &&done_with) const
+{
+  for_each_charged_separation(
+      [&](int i, int j, const double *now) {
+        double then[3];
+        MTS::separation_then(now, delta[i], delta[j], then);
+        visit(i, j, now, then);
+      },
+      done_with);
 }
 
 // the pairs of charged atoms of the group in the list's order (their j and, per i, where
@@ -196,19 +208,14 @@ void CoulFMMNearRefresh::compute_all(const MTS &scheme, double trend, double **o
 void CoulFMMNearRefresh::record_evaluation(double near_cutoff)
 {
   const double cutsq = near_cutoff * near_cutoff;
-  double **x = atom->x;
+  const int nlocal = atom->nlocal;
   double mine = 0.0;
-  for (int ii = 0; ii < list->inum; ii++) {
-    const int i = list->ilist[ii];
-    if (!charged(i)) continue;
-    for (int jj = 0; jj < list->numneigh[i]; jj++) {
-      const int j = list->firstneigh[i][jj] & NEIGHMASK;
-      if (!charged(j)) continue;
-      const double dx = x[i][0] - x[j][0], dy = x[i][1] - x[j][1], dz = x[i][2] - x[j][2];
-      const double r2 = dx * dx + dy * dy + dz * dz;
-      if (r2 < cutsq && r2 != 0.0) mine += near_pair_weight(j, atom->nlocal);
-    }
-  }
+  for_each_charged_separation(
+      [&](int, int j, const double *now) {
+        const double r2 = now[0] * now[0] + now[1] * now[1] + now[2] * now[2];
+        if (r2 < cutsq && r2 != 0.0) mine += near_pair_weight(j, nlocal);
+      },
+      [](int) {});
   MPI_Allreduce(&mine, &near_pairs_evaluated, 1, MPI_DOUBLE, MPI_SUM, world);
   pairs_lost = false;
 }

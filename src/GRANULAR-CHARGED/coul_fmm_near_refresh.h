@@ -79,6 +79,8 @@ class CoulFMMNearRefresh : protected Pointers {
   void exchange_displacements(const class CoulFMMState &state);
   bool charged(int i) const;    // of the fix's group, with a charge
   template <typename Visit, typename DoneWith>
+  void for_each_charged_separation(Visit &&visit, DoneWith &&done_with) const;
+  template <typename Visit, typename DoneWith>
   void for_each_charged_pair(Visit &&visit, DoneWith &&done_with) const;
   void compute_all(const CoulFMMTimeStepping &scheme, double trend, double **out);
 
