@@ -87,7 +87,7 @@ def test_a_negative_area_charge_through_a_study(cli, tmp_path):
     _assert_area_charges(by_charge["-2e-07"], {1: -2e-7, 2: 3e-7})
     _assert_area_charges(by_charge["0"], {1: 0.0, 2: 0.0})
     table = (tmp_path / "toner-output" / "runs.csv").read_text().splitlines()
-    assert table[0].startswith("q_sigma,q_sigma_2,") and len(table) == 3
+    assert table[0].startswith("study,q_sigma,q_sigma_2,") and len(table) == 3
 
 
 def test_a_lammps_error_is_one_line(cli, tmp_path):

@@ -110,16 +110,6 @@ def deck_text(name: str, value) -> str:
     raise ParamError(f"{name} = {value!r}: must be a number, a word or a list of them")
 
 
-def number(name: str, value) -> float:
-    """A study file's value that must be a number, as a float (ParamError naming it)."""
-    try:
-        if isinstance(value, bool):
-            raise ValueError
-        return float(value)
-    except (TypeError, ValueError):
-        raise ParamError(f"{name} = {value!r}: must be a number") from None
-
-
 def params(d: dict) -> list[DepositionParams]:
     """Every run of the study (grid x seeds)."""
     species = d.get("species")
@@ -140,10 +130,8 @@ def params(d: dict) -> list[DepositionParams]:
     fixed = dict(d.get("deck", {}))
     for k in ("rp", "U0", "gamma", "q"):
         if k in fixed:
-            base[k] = number(f"deck.{k}", fixed.pop(k))
+            base[k] = fixed.pop(k)          # checked with every value by DepositionParams
     N = fixed.pop("N", d.get("N", 500))
-    if not (isinstance(N, int) and not isinstance(N, bool) and N >= 1):
-        raise ParamError(f"N = {N!r}: must be a whole number >= 1 (particles per run)")
     refused = dict(RESERVED, seed="seeds = [...] of the study file")
     axes = d.get("axes") or grid_axes(d.get("grid", {}), "study")
     # each axis's points: [{name: value}, ...] (a together axis: the i-th values of its lists)
@@ -157,7 +145,7 @@ def params(d: dict) -> list[DepositionParams]:
             pv = dict(popvars)
             for k, v in point.items():
                 if k in ("U0", "gamma", "q", "rp") and k not in pv:
-                    b[k] = number(f"grid.{k}", v)
+                    b[k] = v
                 elif k in pv or k in param_names():
                     pv[k] = deck_text(f"grid.{k}", v)
                 else:
