@@ -102,7 +102,7 @@ def render(lmp, path: str, rp: float):
         f"amap -0.5 {nz - 0.5} sa 1 {nz} {names}")
 
 
-def _start_time(pid: int) -> str | None:
+def process_start_time(pid: int) -> str | None:
     """The start time of process pid (field 22 of /proc/PID/stat), None if it is gone or a
     zombie: with the pid it names one process, even if the pid is reused later."""
     try:
@@ -120,12 +120,12 @@ def watch_parent(pid: int, interval: float = 0.5):
     is mpirun, which outlives the runner. os._exit: no clean-up that could wait on LAMMPS; the
     run's folder has no result.json and is run again next time. mpirun ends when its ranks
     have."""
-    born = _start_time(pid)
+    born = process_start_time(pid)
     if born is None:
         os._exit(3)
 
     def poll():
-        while _start_time(pid) == born:
+        while process_start_time(pid) == born:
             time.sleep(interval)
         os._exit(3)
 

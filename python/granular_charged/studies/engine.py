@@ -44,6 +44,7 @@ from tqdm.contrib.logging import logging_redirect_tqdm
 
 from ..run.after_formation import table2_complete
 from ..run.estimate import cpu_seconds
+from ..run.child import process_start_time
 from ..run.logs import read_new_lines, relay_case_line
 from ..run.one_case import FAILED
 from ..run.runner import read_result
@@ -355,20 +356,9 @@ def _die_with_parent(sig):
     return preexec
 
 
-def _start_time(pid: int) -> str | None:
-    """The start time of process pid (field 22 of /proc/PID/stat), None if it is gone or a
-    zombie: with the pid it names one process, even if the pid is reused later."""
-    try:
-        stat = Path(f"/proc/{pid}/stat").read_text()
-    except OSError:
-        return None
-    fields = stat[stat.rindex(")") + 2:].split()   # after "pid (comm) "
-    return None if fields[0] in "ZX" else fields[19]
-
-
 def _owner() -> str:
     """This process as the owner of an engine: OWNER_ENV's value."""
-    return f"{socket.gethostname()}:{os.getpid()}:{_start_time(os.getpid())}"
+    return f"{socket.gethostname()}:{os.getpid()}:{process_start_time(os.getpid())}"
 
 
 def guard(argv: list[str]) -> int:
@@ -382,7 +372,7 @@ def guard(argv: list[str]) -> int:
     host, _, rest = os.environ.get(OWNER_ENV, "").partition(":")
     pid, _, born = rest.partition(":")
     watch = host == socket.gethostname() and pid.isdigit()
-    if watch and _start_time(int(pid)) != born:
+    if watch and process_start_time(int(pid)) != born:
         print(f"the study's command (PID {pid}) has ended: this job does not run",
               file=sys.stderr)
         return 1
@@ -410,7 +400,7 @@ def guard(argv: list[str]) -> int:
             break
         except subprocess.TimeoutExpired:
             pass
-        if watch and _start_time(int(pid)) != born:
+        if watch and process_start_time(int(pid)) != born:
             proc.kill()
             proc.wait()
             print(f"    the study's command (PID {pid}) has ended: this job is stopped",
@@ -517,7 +507,7 @@ def live_engines(root: Path) -> list[dict]:
         if b"snakemake" not in cmdline:
             f.unlink(missing_ok=True)
             continue
-        if owner is not None and _start_time(int(owner)) is None:
+        if owner is not None and process_start_time(int(owner)) is None:
             owner = None
         found.append({"host": h, "pid": pid, "owner": owner})
     return found
