@@ -145,12 +145,9 @@ void CoulFMMPolarizable::init_solver(const gcfmm::Options &opts)
     error->all(FLERR,
                "Fix coul/fmm efield, polarize and electrode need farfield exact or none (the "
                "average far field smears charges only)");
-  gcfmm::PolarizationSettings induction;
-  induction.tolerance = s.tolerance > 0.0 ? s.tolerance : 0.1 * opts.accuracy;
-  induction_tolerance = induction.tolerance;
   backend.create(CoulFMMBackend::Kind::POLARIZABLE, opts, s.polarize);
   gcfmm::PolarizableSolver &solver = backend.polarizable().solver();
-  solver.set_induction(induction);
+  induction_tolerance = solver.induction_tolerance();    // gcfmm::Options::induction_tolerance
   // every rank computes its share of the targets of each evaluation, one sum completes them
   // (each value comes from one rank: the same result as on one rank)
   if (comm->nprocs > 1)

@@ -24,22 +24,9 @@
 
 using namespace LAMMPS_NS;
 
-namespace {
-// the static part's share of the requested accuracy: the awake atoms' field is the sum of two
-// approximations (Solver over the awake charges, static field of the sleepers), each with its
-// own error; at half the accuracy each, the sum meets it (measured in test_sleep_gran,
-// CoulombSleepersAreAStaticSource: 1.5e-6 at 1e-6 with the full accuracy for both parts)
-gcfmm::Options static_options(const gcfmm::Options &opts)
-{
-  gcfmm::Options o = opts;
-  o.accuracy = 0.5 * opts.accuracy;
-  return o;
-}
-}    // namespace
-
 CoulFMMSleepers::CoulFMMSleepers(LAMMPS *lmp, const gcfmm::Options &opts, int groupbit_in) :
-    Pointers(lmp), field(new gcfmm::StaticSourceField(static_options(opts))), groupbit(groupbit_in),
-    flags(nullptr), generation(-1), built_generation(-2), built_box{0, 0, 0, 0, 0, 0}
+    Pointers(lmp), field(new gcfmm::StaticSourceField(gcfmm::static_part_options(opts))),
+    groupbit(groupbit_in), flags(nullptr), generation(-1), built_generation(-2), built_box{0, 0, 0, 0, 0, 0}
 {
 }
 

@@ -26,7 +26,6 @@
 #include "update.h"
 
 #include "gcfmm/options.hpp"
-#include "gcfmm/polarizable_solver.hpp"
 
 #include <cmath>
 #include <exception>
@@ -148,6 +147,7 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
     iarg += 1 + nvals;
   }
   if (!any_polar && polar.tolerance > 0.0) error->all(FLERR, "Fix coul/fmm induction needs polarize");
+  opts->induction_tolerance = polar.tolerance;    // 0 when not given: the library's default
   if (polar.polarize) field_cols = 7;
   create_parts(mts);
   if (any_polar)
@@ -247,28 +247,28 @@ void FixCoulFMM::check_boundary_and_options()
                    id);
 }
 
-// a requested accuracy is delivered or refused: beyond order 30 (or the exact periodic far
-// field's finest parameter set) the solver would serve a finer request with a larger error
+// a requested accuracy is delivered or refused: finer than gcfmm::reachable_accuracy the solver
+// would serve the request with a larger error than asked
 void FixCoulFMM::check_accuracy_reachable()
 {
-  const bool dipoles = field_cols == 7;
-  // the induced dipoles' expansions are tightened by this factor (gcfmm::PolarizableSolver)
-  const double margin = dipoles ? gcfmm::PolarizableSolver::dipole_accuracy_margin(opts->accuracy) : 1.0;
-  const double finest = margin * gcfmm::finest_accuracy(*opts);
-  if (opts->accuracy >= finest) return;
-  const bool exact_far = opts->boundary == gcfmm::Boundary::Periodic2D &&
-      opts->farfield == gcfmm::FarField::Exact;
-  std::string why = fmt::format("order {} at theta {:g}", gcfmm::kMaxOrder, gcfmm::resolve(*opts).theta);
-  if (exact_far && finest == margin * gcfmm::kFinestFarFieldAccuracy)
-    why = fmt::format("the exact periodic far field is calibrated down to {:g}",
-                      gcfmm::kFinestFarFieldAccuracy);
-  if (dipoles) why += fmt::format(", times {:g} for the induced dipoles", margin);
+  gcfmm::AccuracyParts parts;
+  parts.dipoles = field_cols == 7;
+  parts.static_sources = sleepers_static && !modify->get_fix_by_style("^sleep/gran$").empty();
+  const gcfmm::ReachableAccuracy reach = gcfmm::reachable_accuracy(*opts, parts);
+  if (opts->accuracy >= reach.accuracy) return;
+  std::string why = reach.limit == gcfmm::AccuracyLimit::ExactFarField
+      ? fmt::format("the exact periodic far field is calibrated down to {:g}", reach.charges)
+      : fmt::format("order {} at theta {:g}", reach.order, reach.theta);
+  if (reach.dipole_margin > 1.0)
+    why += fmt::format(", times {:g} for the induced dipoles", reach.dipole_margin);
+  if (reach.static_share < 1.0)
+    why += fmt::format(", over {:g} for the static sleepers' share", reach.static_share);
   // two digits, rounded up: the suggested request is reachable
-  const double digit = std::pow(10.0, std::floor(std::log10(finest)) - 1.0);
+  const double digit = std::pow(10.0, std::floor(std::log10(reach.accuracy)) - 1.0);
   error->all(FLERR,
              "Fix coul/fmm {} accuracy {:g} is finer than the solver reaches with these "
              "settings: {:.3g} ({}); request accuracy {:.2g} or larger",
-             id, opts->accuracy, finest, why, std::ceil(finest / digit) * digit);
+             id, opts->accuracy, reach.accuracy, why, std::ceil(reach.accuracy / digit) * digit);
 }
 
 void FixCoulFMM::init_list(int /*id*/, NeighList *ptr)

@@ -37,6 +37,11 @@ void Options::validate() const {
     throw std::invalid_argument("gcfmm: bed_zlo and bed_zhi must be given together");
   if (!std::isnan(bed_zlo) && !(bed_zhi > bed_zlo))
     throw std::invalid_argument("gcfmm: bed_zhi must be > bed_zlo, got " + num(bed_zlo) + " .. " + num(bed_zhi));
+  if (!(static_share > 0.0 && static_share <= 1.0))
+    throw std::invalid_argument("gcfmm: static_share must be in (0,1], got " + num(static_share));
+  if (!(induction_tolerance >= 0.0 && induction_tolerance < 1.0))
+    throw std::invalid_argument("gcfmm: induction_tolerance must be in [0,1) (0 = 0.1 x accuracy), got " +
+                                num(induction_tolerance));
 }
 
 // Calibrated model of the relative RMS force error (doc/theory.md, eq. (3.15)):
@@ -76,13 +81,41 @@ Resolved resolve(const Options &o) {
   return r;
 }
 
-double finest_accuracy(const Options &o) {
-  if (o.order > 0) return 0.0;
+double far_field_accuracy(const Options &o) { return std::max(o.accuracy, kFinestFarFieldAccuracy); }
+
+double dipole_accuracy_margin(double accuracy) { return accuracy >= 1e-5 ? 8.0 : 16.0; }
+
+Options static_part_options(const Options &o) {
+  Options s = o;
+  s.accuracy = o.static_share * o.accuracy;
+  return s;
+}
+
+double induction_tolerance(const Options &o) {
+  return o.induction_tolerance > 0.0 ? o.induction_tolerance : 0.1 * o.accuracy;
+}
+
+ReachableAccuracy reachable_accuracy(const Options &o, const AccuracyParts &parts) {
+  ReachableAccuracy r;
+  if (o.order > 0) return r;
   Options finest = o;
-  finest.accuracy = 0.0;    // resolve() then takes kMaxOrder
-  const double near = resolve(finest).estimated_error;
-  const bool exact_far = o.boundary == Boundary::Periodic2D && o.farfield == FarField::Exact;
-  return exact_far ? std::max(near, kFinestFarFieldAccuracy) : near;
+  finest.accuracy = 0.0;  // resolve() then takes kMaxOrder
+  const Resolved at_max = resolve(finest);
+  r.order = at_max.order;
+  r.theta = at_max.theta;
+  r.charges = at_max.estimated_error;
+  r.limit = AccuracyLimit::MaxOrder;
+  // below its finest set the exact far field is set up at that set (far_field_accuracy())
+  if (o.boundary == Boundary::Periodic2D && o.farfield == FarField::Exact && kFinestFarFieldAccuracy > r.charges) {
+    r.charges = kFinestFarFieldAccuracy;
+    r.limit = AccuracyLimit::ExactFarField;
+  }
+  if (parts.dipoles) r.dipole_margin = dipole_accuracy_margin(o.accuracy);
+  if (parts.static_sources) r.static_share = o.static_share;
+  // each part's expansions run at the request scaled by its factor: the request is reachable
+  // when every part's is
+  r.accuracy = r.charges * std::max(r.dipole_margin, 1.0 / r.static_share);
+  return r;
 }
 
 }  // namespace gcfmm

@@ -14,14 +14,14 @@ namespace gcfmm {
 
 namespace {
 Options expansion_options(Options opts, bool dipoles) {
-  if (dipoles && opts.order <= 0) opts.accuracy /= PolarizableSolver::dipole_accuracy_margin(opts.accuracy);
+  if (dipoles && opts.order <= 0) opts.accuracy /= dipole_accuracy_margin(opts.accuracy);
   return opts;
 }
 }  // namespace
 
 PolarizableSolver::PolarizableSolver(const Options &opts, bool dipoles) : solver_(expansion_options(opts, dipoles)) {
   PolarizationSettings s;
-  s.tolerance = 0.1 * opts.accuracy;
+  s.tolerance = gcfmm::induction_tolerance(opts);
   set_induction(s);
 }
 

@@ -228,9 +228,7 @@ void SolverCore::find_coincident_pairs() {
 
 void SolverCore::setup_far_field() {
   if (!periodic() || opts.farfield != FarField::Exact) return;
-  // the lattice sum accepts accuracies down to kFinestFarFieldAccuracy (its far field is
-  // smooth and tiny anyway)
-  const double facc = std::max(opts.accuracy, kFinestFarFieldAccuracy);
+  const double facc = far_field_accuracy(opts);
   double lo = zmin, hi = zmax;
   if (!std::isnan(zhint_lo)) {
     lo = std::min(lo, zhint_lo * inv_h);

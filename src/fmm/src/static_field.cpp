@@ -205,7 +205,7 @@ void StaticSourceField::Impl::prepare_far_field() {
   }
   cover_lo = lo;
   cover_hi = hi;
-  const double facc = std::max(opts.accuracy, kFinestFarFieldAccuracy);  // as Solver::Impl::setup_far_field
+  const double facc = far_field_accuracy(opts);
   stats.t_far_setup = timed([&] {
     if (far.needs_setup(sx0, sy0, slx, sly, lo, hi, opts.images, facc)) {
       far.setup(sx0, sy0, slx, sly, lo, hi, opts.images, facc);

@@ -39,13 +39,9 @@ class PolarizableSolver {
   /** @param dipoles whether compute() will be given polarizabilities. Their forces G p need the
    *  field gradient, whose error at a given expansion order is larger than the field's
    *  (doc/benchmarks.md, "Induced dipoles"): the expansions are then chosen for
-   *  Options::accuracy divided by dipole_accuracy_margin() (an order given explicitly is
-   *  kept). */
+   *  Options::accuracy divided by gcfmm::dipole_accuracy_margin() (an order given explicitly
+   *  is kept). The induction stops at gcfmm::induction_tolerance(opts). */
   explicit PolarizableSolver(const Options &opts, bool dipoles = true);
-  /** @brief The calibrated factor by which the expansions' accuracy is tightened for dipoles at
-   *  a requested accuracy (doc/benchmarks.md, "Induced dipoles"): 8 down to 1e-5, 16 below,
-   *  where the exact far field's gradient needs the tighter margin to deliver the request. */
-  static double dipole_accuracy_margin(double accuracy) { return accuracy >= 1e-5 ? 8.0 : 16.0; }
   /** @brief Periodic2D: the primary cell (Solver::set_box). */
   void set_box(double xlo, double ylo, double lx, double ly);
   /** @brief Periodic2D with FarField::Exact: the z range the far field covers (Solver::
@@ -53,9 +49,11 @@ class PolarizableSolver {
   void set_z_range(double zlo, double zhi);
   /** @throws std::invalid_argument if a component of the field or electrode_z is not finite. */
   void set_environment(const PolarizableEnvironment &env);
-  /** @brief The induction's stopping rule (default: residual 0.1 x Options::accuracy): a
-   *  start within `tolerance` is accepted, iterations go on to tolerance / 4. */
+  /** @brief The induction's stopping rule (default: residual gcfmm::induction_tolerance() of
+   *  the options): a start within `tolerance` is accepted, iterations go on to tolerance / 4. */
   void set_induction(const PolarizationSettings &settings);
+  /** @brief The induction's residual in use (set_induction()'s tolerance). */
+  double induction_tolerance() const { return induction_.accept_start; }
   /** @brief Split every evaluation among nparts callers running at once (e.g. MPI ranks):
    *  each computes the targets of its work partition (Solver::evaluate_dipoles) and `sum`
    *  adds the callers' results in place (each value is nonzero on one caller only, so the
