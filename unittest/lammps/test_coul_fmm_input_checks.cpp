@@ -122,6 +122,21 @@ TEST(CoulFMMInputChecks, UnreachableAccuracyIsAnError)
                "the induced dipoles\\)");
   // a smaller theta reaches further
   EXPECT_EQ(refused("f f f", "fix fmm all coul/fmm accuracy 1e-12 theta 0.4"), "no error");
+  // with fix sleep/gran the sleepers' static field runs at half the request (gcfmm::Options::
+  // static_share): 1.5e-8 is within the exact far field's 1e-8, not within its half
+  auto with_sleepers = [](const std::string &fix) {
+    Lmp l;
+    charges(l, "p p f", "hybrid sphere charge");
+    return error_in(l, {"comm_modify vel yes", "pair_style granular",
+                        "pair_coeff * * hooke 1000 50 tangential linear_nohistory 1.0 0.0", fix,
+                        "fix sleep all sleep/gran speed 1 force 1 wake 1 time 0", "run 0 post no"});
+  };
+  expect_match(with_sleepers("fix fmm all coul/fmm accuracy 1.5e-8"),
+               "accuracy 1.5e-08 is finer than the solver reaches with these settings: 2e-08 "
+               "\\(the exact periodic far field is calibrated down to 1e-08, over 0.5 for the "
+               "static sleepers' share\\); request accuracy 2e-08 or larger");
+  EXPECT_EQ(with_sleepers("fix fmm all coul/fmm accuracy 2e-8"), "no error");
+  EXPECT_EQ(with_sleepers("fix fmm all coul/fmm accuracy 1.5e-8 sleepers full"), "no error");
   EXPECT_EQ(refused("f f f", "fix fmm all coul/fmm accuracy 2e-10"), "no error");
   EXPECT_EQ(refused("p p f", "fix fmm all coul/fmm accuracy 1e-8"), "no error");
   EXPECT_EQ(refused("f f f", "fix fmm all coul/fmm accuracy 1e-12 order 12"), "no error");
