@@ -26,7 +26,8 @@ using namespace LAMMPS_NS;
 
 CoulFMMSleepers::CoulFMMSleepers(LAMMPS *lmp, const gcfmm::Options &opts, int groupbit_in) :
     Pointers(lmp), field(new gcfmm::StaticSourceField(gcfmm::static_part_options(opts))),
-    groupbit(groupbit_in), flags(nullptr), generation(-1), built_generation(-2), built_box{0, 0, 0, 0, 0, 0}
+    groupbit(groupbit_in), flags(nullptr), generation(-1), built_generation(-2),
+    built_box{0, 0, 0, 0, 0, 0}
 {
 }
 

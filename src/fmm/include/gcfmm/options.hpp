@@ -78,8 +78,7 @@ double dipole_accuracy_margin(double accuracy);
 Options static_part_options(const Options &opts);
 
 /** @brief PolarizableSolver's induction residual: Options::induction_tolerance, or 0.1 x
- *  accuracy when it is 0 (a tenth: the dipoles' error then adds little to the expansions'
- *  at the request, doc/polarization.md, section 5). */
+ *  accuracy when it is 0 (doc/polarization.md, section 6). */
 double induction_tolerance(const Options &opts);
 
 //! What sets the finest accuracy some options reach (reachable_accuracy()).
