@@ -306,6 +306,7 @@ TEST(FixSleepGran, CoulombSleepersAreAStaticSource)
   }
 }
 
+namespace {
 // the Coulomb forces q E at the awake atoms (E: fix coul/fmm's per-atom field), by atom ID: the
 // forces fix coul/fmm's accuracy is defined for, without the contact forces that f also holds
 std::vector<double> awake_coulomb_forces(Lmp &l, const std::vector<double> &sleeping)
@@ -319,6 +320,7 @@ std::vector<double> awake_coulomb_forces(Lmp &l, const std::vector<double> &slee
       for (int k = 0; k < 3; k++) out.push_back(q[i] * field[4 * i + k]);
   return out;
 }
+}    // namespace
 
 // accuracy is the relative RMS Coulomb force error over the atoms the solver evaluates
 // (doc/fmm-accuracy.md): with static sleepers, the awake atoms, whose field is the sum of the
@@ -337,7 +339,11 @@ TEST(FixSleepGran, CoulombStaticSleepersMeetTheRequestAtTheAwakeAtoms)
       const double err = rel_rms(awake_coulomb_forces(l, sleeping), fref);
       std::printf("[ static sleepers, %s ] accuracy %g: Coulomb force error at the awake atoms %.3g\n",
                   solver, acc, err);
-      // the reference's own error (1e-9) is below 1e-3 of the smaller request
+      // measured 2.8e-5 to 3.7e-5 at 1e-4, 5.3e-9 to 2.1e-8 at 1e-6, with either solver on 1
+      // and 2 ranks (the bed's random signs
+      // do not cancel: the request holds against the force itself, doc/fmm-accuracy.md, "Fields
+      // that cancel"); 4.5e-4 at 1e-4 with the static field run 50 times looser. The
+      // reference's own error (1e-9) is 1e-3 of the smaller request.
       EXPECT_LT(err, acc);
       EXPECT_GT(err, 0.0) << "two different evaluations";
     }
