@@ -340,10 +340,10 @@ TEST(FixSleepGran, CoulombStaticSleepersMeetTheRequestAtTheAwakeAtoms)
       std::printf("[ static sleepers, %s ] accuracy %g: Coulomb force error at the awake atoms %.3g\n",
                   solver, acc, err);
       // measured 2.8e-5 to 3.7e-5 at 1e-4, 5.3e-9 to 2.1e-8 at 1e-6, with either solver on 1
-      // and 2 ranks (the bed's random signs
-      // do not cancel: the request holds against the force itself, doc/fmm-accuracy.md, "Fields
-      // that cancel"); 4.5e-4 at 1e-4 with the static field run 50 times looser. The
-      // reference's own error (1e-9) is 1e-3 of the smaller request.
+      // and 2 ranks (the bed's random signs do not cancel: the request holds against the force
+      // itself, doc/fmm-accuracy.md, "Fields that cancel"); 4.5e-4 at 1e-4 with the static
+      // field run 50 times looser. The reference's own error (1e-9) is 1e-3 of the smaller
+      // request.
       EXPECT_LT(err, acc);
       EXPECT_GT(err, 0.0) << "two different evaluations";
     }
