@@ -28,7 +28,7 @@ add_dependencies(test_granular_opt_switch lmp)
 # stops the rank that owns it)
 gc_lammps_test(test_coul_fmm_input_checks SOURCES test_coul_fmm_input_checks.cpp)
 # the Marshall contacts in SIMD lanes against the scalar kernel on every path the CPU has, and
-# a bed run with GCFMM_SIMD=generic against the default path (separate lmp processes: the path
+# a bed run with GCSIMD_MAX_PATH=generic against the default path (separate lmp processes: the path
 # is chosen once per process). Bit for bit, so compiled as marshall_lanes.cpp is.
 gc_lammps_test(test_marshall_lanes SOURCES test_marshall_lanes.cpp)
 target_include_directories(test_marshall_lanes PRIVATE ${CMAKE_SOURCE_DIR}/src/simd/include)
