@@ -34,7 +34,9 @@ namespace {
 // what pack_forward_comm() and pack_reverse_comm() move
 enum CommMode { COMM_FLAGS, COMM_PUSHED, COMM_PUSH, COMM_WAKE };
 // slots of the global restart list
-enum RestartSlot { R_SLEEP_EVENTS, R_WAKE_EVENTS, R_NSLOTS };
+enum RestartSlot { R_FALLEN_ASLEEP, R_WOKEN, R_NSLOTS };
+// the elements of the global vector (compute_vector's index)
+enum VectorElement { V_AWAKE, V_SLEEPING, V_FALLEN_ASLEEP, V_WOKEN, V_NELEMENTS };
 }    // namespace
 
 /* ---------------------------------------------------------------------- */
@@ -43,8 +45,7 @@ FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), speed_sleep(-1.0), force_sleep(-1.0), force_wake(-1.0), rest_time(-1.0),
     depth(0.0), every(100), rest_steps_needed(0), rest_rule(true), asleep(nullptr), pushed(nullptr),
     rest_steps(nullptr), push(nullptr), wake_mark(nullptr), ncontact(nullptr), comm_mode(COMM_FLAGS),
-    set_generation(0), nsleep_events(0), nwake_events(0), pair_bookkeeping(false),
-    pair_history(nullptr)
+    set_generation(0), fallen_asleep_total(0), woken_total(0), pair_history(nullptr)
 {
   if (!(atom->radius_flag && atom->rmass_flag && atom->omega_flag && atom->torque_flag))
     error->all(FLERR, "Fix {} requires atom attributes radius, rmass, omega and torque (atom_style sphere)", style);
@@ -94,7 +95,7 @@ FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
 
   scalar_flag = 1;
   vector_flag = 1;
-  size_vector = 4;
+  size_vector = V_NELEMENTS;
   global_freq = 1;
   extscalar = 0;
   extvector = 0;
@@ -145,8 +146,8 @@ void FixSleepGran::init()
   if (!force->pair_match("^granular", 0) || !force->pair->single_enable)
     error->all(FLERR, "Fix {} requires pair_style granular or granular/opt, not {}", style,
                force->pair_style ? force->pair_style : "none");
-  int dim = 0;
-  pair_bookkeeping = force->pair->extract("sleep/gran:bookkeeping", dim) != nullptr;
+  if (modify->get_fix_by_style("^sleep/gran$").size() > 1)
+    error->all(FLERR, "Only one fix sleep/gran may be defined");
   // the pair style's contact flags, if its models keep a history (fix neigh/history)
   auto histories = modify->get_fix_by_style("^NEIGH_HISTORY$");
   if (histories.size() > 1)
@@ -232,7 +233,7 @@ void FixSleepGran::exchange_flags()
 
 void FixSleepGran::post_force(int /*vflag*/)
 {
-  if (!pair_bookkeeping) sum_contacts_and_push();
+  sum_contacts_and_push();
   if (force->newton_pair) {
     comm_mode = COMM_PUSH;
     comm->reverse_comm(this, 4);
@@ -252,9 +253,9 @@ void FixSleepGran::post_force(int /*vflag*/)
   }
 
   // falling asleep happens only on commit steps (fall_asleep() sums its count over the ranks)
-  const bigint before = nsleep_events;
+  const bigint before = fallen_asleep_total;
   if (update->ntimestep % every == 0) fall_asleep();
-  if (nsleep_events != before) {
+  if (fallen_asleep_total != before) {
     exchange_flags();
     set_generation++;
   }
@@ -262,9 +263,10 @@ void FixSleepGran::post_force(int /*vflag*/)
 }
 
 /* ----------------------------------------------------------------------
-   with a pair style that does not do the sleepers' bookkeeping: the contacts of this step
-   (touching pairs but those of two sleepers) and, for each sleeper, the contact forces of its
-   awake partners, recomputed by the pair's single() from the pair's neighbor list
+   the contacts of this step (touching pairs but those of two sleepers) and, for each sleeper,
+   the contact forces of its awake partners, recomputed by the pair's single() from the pair's
+   neighbor list after the pair has advanced the contact histories by the step: one bookkeeping
+   for every pair style, so that the wake decisions do not depend on the style
 ------------------------------------------------------------------------- */
 
 void FixSleepGran::sum_contacts_and_push()
@@ -372,7 +374,7 @@ void FixSleepGran::wake_pushed()
   }
   bigint nw = nwoken, all = 0;
   MPI_Allreduce(&nw, &all, 1, MPI_LMP_BIGINT, MPI_SUM, world);
-  nwake_events += all;
+  woken_total += all;
   exchange_flags();
   set_generation++;
 }
@@ -433,7 +435,7 @@ void FixSleepGran::fall_asleep()
   }
   bigint all = 0;
   MPI_Allreduce(&n, &all, 1, MPI_LMP_BIGINT, MPI_SUM, world);
-  nsleep_events += all;
+  fallen_asleep_total += all;
 }
 
 /* ----------------------------------------------------------------------
@@ -510,13 +512,18 @@ bigint FixSleepGran::sleeping_count() const
   return all;
 }
 
+bigint FixSleepGran::awake_count() const
+{
+  return atom->natoms - sleeping_count();
+}
+
 /* ----------------------------------------------------------------------
-   the scalar is the awake count (the atoms still integrated), the same as vector element 1
+   the scalar: the awake count (the atoms still integrated), as vector element 1
 ------------------------------------------------------------------------- */
 
 double FixSleepGran::compute_scalar()
 {
-  return static_cast<double>(atom->natoms - sleeping_count());
+  return static_cast<double>(awake_count());
 }
 
 /* ----------------------------------------------------------------------
@@ -526,10 +533,16 @@ double FixSleepGran::compute_scalar()
 
 double FixSleepGran::compute_vector(int n)
 {
-  if (n == 0) return static_cast<double>(atom->natoms - sleeping_count());
-  if (n == 1) return static_cast<double>(sleeping_count());
-  if (n == 2) return static_cast<double>(nsleep_events);
-  return static_cast<double>(nwake_events);
+  switch (n) {
+    case V_AWAKE:
+      return static_cast<double>(awake_count());
+    case V_SLEEPING:
+      return static_cast<double>(sleeping_count());
+    case V_FALLEN_ASLEEP:
+      return static_cast<double>(fallen_asleep_total);
+    default:
+      return static_cast<double>(woken_total);
+  }
 }
 
 /* ---------------------------------------------------------------------- */
@@ -654,8 +667,8 @@ void FixSleepGran::write_restart(FILE *fp)
 {
   if (comm->me != 0) return;
   double list[R_NSLOTS];
-  list[R_SLEEP_EVENTS] = static_cast<double>(nsleep_events);
-  list[R_WAKE_EVENTS] = static_cast<double>(nwake_events);
+  list[R_FALLEN_ASLEEP] = static_cast<double>(fallen_asleep_total);
+  list[R_WOKEN] = static_cast<double>(woken_total);
   int size = R_NSLOTS * sizeof(double);
   fwrite(&size, sizeof(int), 1, fp);
   fwrite(list, sizeof(double), R_NSLOTS, fp);
@@ -664,8 +677,8 @@ void FixSleepGran::write_restart(FILE *fp)
 void FixSleepGran::restart(char *buf)
 {
   auto *list = reinterpret_cast<double *>(buf);
-  nsleep_events = static_cast<bigint>(list[R_SLEEP_EVENTS]);
-  nwake_events = static_cast<bigint>(list[R_WAKE_EVENTS]);
+  fallen_asleep_total = static_cast<bigint>(list[R_FALLEN_ASLEEP]);
+  woken_total = static_cast<bigint>(list[R_WOKEN]);
 }
 
 int FixSleepGran::pack_restart(int i, double *buf)
