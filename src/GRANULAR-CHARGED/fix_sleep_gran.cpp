@@ -23,6 +23,7 @@
 #include "pair.h"
 #include "update.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -266,7 +267,10 @@ void FixSleepGran::post_force(int /*vflag*/)
    the contacts of this step (touching pairs but those of two sleepers) and, for each sleeper,
    the contact forces of its awake partners, recomputed by the pair's single() from the pair's
    neighbor list after the pair has advanced the contact histories by the step: one bookkeeping
-   for every pair style, so that the wake decisions do not depend on the style
+   for every pair style, so that the wake decisions do not depend on the style. single() of a
+   sliding model rewrites the history of a slipping contact (LAMMPS's mindlin does, and the
+   Marshall set with it), at the level of rounding: the contact's history is restored after it,
+   so that the trajectory is the one without this fix
 ------------------------------------------------------------------------- */
 
 void FixSleepGran::sum_contacts_and_push()
@@ -279,6 +283,8 @@ void FixSleepGran::sum_contacts_and_push()
   const int nlocal = atom->nlocal;
   const int newton_pair = force->newton_pair;
   double *special_lj = force->special_lj;
+  const int size_history = pair_history ? pair_history->get_dnum() : 0;
+  kept_history.resize(size_history);
   for (int ii = 0; ii < list->inum; ii++) {
     const int i = list->ilist[ii];
     const int *jlist = list->firstneigh[i];
@@ -295,7 +301,10 @@ void FixSleepGran::sum_contacts_and_push()
       double dx[3] = {x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]};
       const double rsq = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
       double fpair = 0.0;
+      double *history = pair_history ? &pair_history->firstvalue[i][size_history * jj] : nullptr;
+      if (history) std::copy(history, history + size_history, kept_history.begin());
       pair->single(i, j, type[i], type[j], rsq, 1.0, factor_lj, fpair);
+      if (history) std::copy(kept_history.begin(), kept_history.end(), history);
       // the force on i: normal (fpair along dx) plus the sliding force svector[0..2]
       for (int k = 0; k < 3; k++) {
         const double fk = factor_lj * (fpair * dx[k] + pair->svector[k]);

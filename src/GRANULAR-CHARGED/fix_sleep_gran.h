@@ -92,6 +92,7 @@ class FixSleepGran : public Fix {
   // atoms that fell asleep and atoms woken since the fix was defined (kept across restarts)
   bigint fallen_asleep_total, woken_total;
   class FixNeighHistory *pair_history;    // the pair style's contact flags (null: none)
+  std::vector<double> kept_history;       // one contact's history, kept across single()
 
   void exchange_flags();
   void sum_contacts_and_push();
