@@ -46,7 +46,8 @@ FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), speed_sleep(-1.0), force_sleep(-1.0), force_wake(-1.0), rest_time(-1.0),
     depth(0.0), every(100), rest_steps_needed(0), rest_rule(true), asleep(nullptr), pushed(nullptr),
     rest_steps(nullptr), push(nullptr), wake_mark(nullptr), ncontact(nullptr), comm_mode(COMM_FLAGS),
-    set_generation(0), fallen_asleep_total(0), woken_total(0), pair_history(nullptr)
+    set_generation(0), fallen_asleep_total(0), woken_total(0), pair_history(nullptr),
+    active_build(-1), active_generation(-1)
 {
   if (!(atom->radius_flag && atom->rmass_flag && atom->omega_flag && atom->torque_flag))
     error->all(FLERR, "Fix {} requires atom attributes radius, rmass, omega and torque (atom_style sphere)", style);
@@ -165,6 +166,7 @@ void FixSleepGran::init()
   }
   if (update->whichflag == 2) error->all(FLERR, "Fix {} cannot be used with minimization", style);
   check_fix_order();
+  active_build = active_generation = -1;    // the pair's list may be another one
   rest_steps_needed = static_cast<int>(std::ceil(rest_time / update->dt - 1e-9));
 }
 
@@ -285,7 +287,8 @@ void FixSleepGran::sum_contacts_and_push()
   double *special_lj = force->special_lj;
   const int size_history = pair_history ? pair_history->get_dnum() : 0;
   kept_history.resize(size_history);
-  for (int ii = 0; ii < list->inum; ii++) {
+  update_active_entries(list);
+  for (const int ii : active_entries) {
     const int i = list->ilist[ii];
     const int *jlist = list->firstneigh[i];
     const int *touch = pair_history ? pair_history->firstflag[i] : nullptr;
@@ -312,6 +315,27 @@ void FixSleepGran::sum_contacts_and_push()
         if (asleep[j] != 0.0 && j_here) push[j][k] -= fk;
       }
     }
+  }
+}
+
+/* ----------------------------------------------------------------------
+   the entries of the pair's list that hold a pair with an awake atom (an awake atom, or a
+   sleeper with an awake neighbor), rebuilt after each neighbor list build and each change of
+   the sleeping set
+------------------------------------------------------------------------- */
+
+void FixSleepGran::update_active_entries(const NeighList *list)
+{
+  if (active_build == neighbor->lastcall && active_generation == set_generation) return;
+  active_build = neighbor->lastcall;
+  active_generation = set_generation;
+  active_entries.clear();
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    bool keep = asleep[i] == 0.0;
+    const int *jlist = list->firstneigh[i];
+    for (int jj = 0; !keep && jj < list->numneigh[i]; jj++) keep = asleep[jlist[jj] & NEIGHMASK] == 0.0;
+    if (keep) active_entries.push_back(ii);
   }
 }
 

@@ -93,9 +93,13 @@ class FixSleepGran : public Fix {
   bigint fallen_asleep_total, woken_total;
   class FixNeighHistory *pair_history;    // the pair style's contact flags (null: none)
   std::vector<double> kept_history;       // one contact's history, kept across single()
+  // the entries of the pair's list with an awake atom or neighbor (update_active_entries())
+  std::vector<int> active_entries;
+  bigint active_build, active_generation;    // the list build and sleeping set they are of
 
   void exchange_flags();
   void sum_contacts_and_push();
+  void update_active_entries(const class NeighList *list);
   void mark_touching_sleepers();
   bool touching(int i, int j, int jj, const int *touch) const;
   bigint sleeping_count() const;
