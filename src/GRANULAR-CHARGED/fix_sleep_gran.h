@@ -32,8 +32,8 @@ namespace LAMMPS_NS {
 //
 // This fix keeps its own books for every granular pair style: it counts the contacts from the
 // pair's neighbor list and contact flags and sums the push of each awake-sleeper contact with
-// the pair's single(). The state is published through extract() (names below), so that a pair
-// style or compute may read it without including this header.
+// the pair's single(). The state is published through extract() (names below), so that other
+// styles (fix coul/fmm) read it without including this header.
 class FixSleepGran : public Fix {
  public:
   FixSleepGran(class LAMMPS *, int, char **);
