@@ -19,6 +19,8 @@ gc_lammps_test(test_coul_fmm_polarize NP 1 2 SOURCES test_coul_fmm_polarize.cpp)
 gc_lammps_test(test_wall_gran_opt NP 1 2 SOURCES test_wall_gran_opt.cpp)
 # which sleepers fix sleep/gran wakes, on every processor grid of 1, 2 and 3 ranks
 gc_lammps_test(test_sleep_wake NP 1 2 3 SOURCES test_sleep_wake.cpp)
+# fix sleep/gran with granular and granular/opt: the same trajectory, on 1 and 3 ranks
+gc_lammps_test(test_sleep_styles NP 1 3 SOURCES test_sleep_styles.cpp)
 # warnings for inputs LAMMPS accepts that give another answer than meant (read from the log)
 gc_lammps_test(test_silent_mistakes NP 1 2 SOURCES test_silent_mistakes.cpp)
 gc_lammps_test(test_granular_opt_switch SOURCES test_granular_opt_switch.cpp)
