@@ -55,10 +55,9 @@ class CoulFMMPolarizable : public CoulFMMScheme, protected Pointers {
   ~CoulFMMPolarizable() override;
 
   // CoulFMMScheme: evaluations on the schedule's steps, continued in between (advance)
-  // (doc/polarization.md, section 8); a minimizer's call always evaluates
+  // (doc/polarization.md, section 8)
   void init() override;
   bool continues() override { return false; }    // an evaluation at every setup
-  double compute(bool predict) override;
   bool acts_on(int i) const override;
   const Diagnostics &diagnostics() const override { return diag; }
   double evaluations() const override { return nevaluations; }
@@ -89,6 +88,11 @@ class CoulFMMPolarizable : public CoulFMMScheme, protected Pointers {
   const Settings &settings() const { return s; }
   double memory_usage() const override;
 
+ protected:
+  bool evaluation_due() override;
+  bool continue_last(double &energy) override;
+  double evaluate(Evaluation why) override;
+
  private:
   Settings s;
   Parts parts;
@@ -114,7 +118,7 @@ class CoulFMMPolarizable : public CoulFMMScheme, protected Pointers {
   double last_residual = 0.0;
 
   // the last evaluation, in the gathered order (bare units; positions interleaved, 3 per atom)
-  struct Evaluation {
+  struct LastEvaluation {
     std::vector<tagint> tag;
     std::vector<double> x, q, p, field, force, energy;
     std::vector<double> slope;    // trend of the far part of the force per step (eq. (8.3))
@@ -134,7 +138,7 @@ class CoulFMMPolarizable : public CoulFMMScheme, protected Pointers {
 
   void gather();
   void map_local();
-  bool continue_last(gcfmm::NearChange &change, const std::vector<size_t> &targets);
+  bool near_change(gcfmm::NearChange &change, const std::vector<size_t> &targets);
   double store(double **field, double **force, const gcfmm::NearChange *change, double steps);
   std::string below_electrode() const;
 };
