@@ -112,7 +112,7 @@ double CoulFMMPolarizable::evaluate(Evaluation why)
   CoulFMMTimeStepping &stepping = *parts.stepping;
   CoulFMMState &state = *parts.state;
   const bool predict = why != Evaluation::FRESH;
-  const double energy = evaluate(state.field_rows(), state.force_rows(), predict, stepping.stride());
+  const double energy = solve(state.field_rows(), state.force_rows(), predict, stepping.stride());
   nevaluations += 1.0;
   if (predict) {
     if (prediction_error() >= 0.0) stepping.adapt(prediction_error());
@@ -295,7 +295,7 @@ bool CoulFMMPolarizable::advance(double **field, double **force_out, double &ene
   return true;
 }
 
-double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool predict, int stride)
+double CoulFMMPolarizable::solve(double **field, double **force_out, bool predict, int stride)
 {
   parts.state->check_charges(parts.fix->id);
   gather();
@@ -362,8 +362,6 @@ double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool pre
   for (size_t k = 0; k < n; k++)
     for (int a = 0; a < 3; a++) eval.field[3 * k + a] = e3[a * n + k];
   const gcfmm::BackendStats rep = backend.solver().stats();
-  last_iterations = rep.iterations;
-  last_residual = rep.residual;
   diag.estimated_error = rep.estimated_error;
   diag.order = rep.order;
   diag.m2l = rep.m2l;

@@ -61,31 +61,6 @@ class CoulFMMPolarizable : public CoulFMMScheme, protected Pointers {
   bool acts_on(int i) const override;
   const Diagnostics &diagnostics() const override { return diag; }
   double evaluations() const override { return nevaluations; }
-
-  // field[i][0..3] = Ex, Ey, Ez (applied field included) and the potential of the charges;
-  // field[i][4..6] = the dipole (charge x distance; polarize only); force[i][0..2] = q E + (p . grad) E, all in
-  // LAMMPS units, zero outside the group; returns this rank's part of the energy
-  // predict: start from the dipoles extrapolated from the last two steps when they were the
-  // two steps before this one (false: from the last solution; e.g. in a minimization)
-  // stride: the time stepping's interval now (a trend of the far part is taken only over at
-  // least that many steps)
-  double evaluate(double **field, double **force, bool predict = true, int stride = 1);
-  // the same outputs from the last evaluation continued to the atoms now (its values plus the
-  // near pairs' change within `cutoff` since then, dipoles held; the far part held). False
-  // (nothing written) when it cannot be continued: no evaluation yet, other atoms or charges,
-  // or displacements too large for the periodic cell; the caller then evaluates.
-  bool advance(double **field, double **force, double &energy);
-  // the near cutoff of advance() (0: only the evaluation's values, held), whether evaluate()
-  // measures the error of the continued forces (the multiple time stepping is on), and whether
-  // the far part of the force follows its trend over the last interval (extrapolate)
-  void set_time_stepping(double cutoff, bool measure, bool extrapolate);
-  // relative RMS difference of the continued forces from those of the last evaluate() (over
-  // the group's charged and polarizable atoms); -1 if that evaluation continued nothing
-  double prediction_error() const { return last_prediction_error; }
-
-  int iterations() const { return last_iterations; }
-  double residual() const { return last_residual; }
-  const Settings &settings() const { return s; }
   double memory_usage() const override;
 
  protected:
@@ -94,6 +69,27 @@ class CoulFMMPolarizable : public CoulFMMScheme, protected Pointers {
   double evaluate(Evaluation why) override;
 
  private:
+  // field[i][0..3] = Ex, Ey, Ez (applied field included) and the potential of the charges;
+  // field[i][4..6] = the dipole (charge x distance; polarize only); force[i][0..2] = q E + (p . grad) E, all in
+  // LAMMPS units, zero outside the group; returns this rank's part of the energy
+  // predict: start from the dipoles extrapolated from the last two steps when they were the
+  // two steps before this one (false: from the last solution; e.g. in a minimization)
+  // stride: the time stepping's interval now (a trend of the far part is taken only over at
+  // least that many steps)
+  double solve(double **field, double **force, bool predict, int stride);
+  // the same outputs from the last evaluation continued to the atoms now (its values plus the
+  // near pairs' change within `cutoff` since then, dipoles held; the far part held). False
+  // (nothing written) when it cannot be continued: no evaluation yet, other atoms or charges,
+  // or displacements too large for the periodic cell; the caller then evaluates.
+  bool advance(double **field, double **force, double &energy);
+  // the near cutoff of advance() (0: only the evaluation's values, held), whether solve()
+  // measures the error of the continued forces (the multiple time stepping is on), and whether
+  // the far part of the force follows its trend over the last interval (extrapolate)
+  void set_time_stepping(double cutoff, bool measure, bool extrapolate);
+  // relative RMS difference of the continued forces from those of the last solve() (over
+  // the group's charged and polarizable atoms); -1 if that evaluation continued nothing
+  double prediction_error() const { return last_prediction_error; }
+
   Settings s;
   Parts parts;
   int groupbit;
@@ -114,8 +110,6 @@ class CoulFMMPolarizable : public CoulFMMScheme, protected Pointers {
   std::vector<tagint> last_tag, prev_tag;
   std::vector<double> last_p, prev_p;
   bigint last_step = -1, prev_step = -1;
-  int last_iterations = 0;
-  double last_residual = 0.0;
 
   // the last evaluation, in the gathered order (bare units; positions interleaved, 3 per atom)
   struct LastEvaluation {
