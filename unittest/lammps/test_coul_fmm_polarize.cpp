@@ -212,6 +212,36 @@ TEST(CoulFMMPolarize, OneVersusTwoRanks)
   EXPECT_LT(rel_rms(two, one), 1e-12);
 }
 
+// enough atoms that the ranks split the FMM's targets (the 40 above fit in the solver's direct
+// sum, which every rank does whole): each rank computes its share and one sum over the ranks
+// completes it (CoulFMMBackend's partition sum). Each value comes from one rank, so 1 and 2
+// ranks agree to round-off; without the sum the 2-rank energy is half the 1-rank one.
+TEST(CoulFMMPolarize, OneVersusTwoRanksSharingTheWork)
+{
+  if (gctest::nprocs() != 2) GTEST_SKIP() << "needs mpirun -np 2";
+  auto run = [&](MPI_Comm comm) {
+    Lmp l(comm);
+    l.cmds({"units real", "atom_style hybrid sphere charge", "atom_modify map array sort 0 0",
+            "boundary p p f", "region box block 0 24 0 24 0 40", "create_box 1 box",
+            "neighbor 1.0 bin", "pair_style zero 5.0", "pair_coeff * *",
+            "lattice sc 3.0 origin 0.5 0.5 0.7", "region r block 0 8 0 8 0 5",
+            "create_atoms 1 region r", "displace_atoms all random 0.2 0.2 0.2 7 units box",
+            "variable qq atom 0.3*(2*(id%2)-1)", "set group all charge v_qq diameter 2.0 density 1.0",
+            "fix fmm all coul/fmm accuracy 1e-6 polarize 3.8 efield 0 0 0.4 electrode 0.5",
+            "fix_modify fmm energy yes", "thermo_style custom step pe", "run 0 post no"});
+    auto f = gather(l, "f", 3);
+    f.push_back(l.var("f_fmm"));
+    return f;
+  };
+  const auto two = run(MPI_COMM_WORLD);
+  std::vector<double> one(two.size());
+  if (gctest::rank() == 0) one = run(MPI_COMM_SELF);
+  MPI_Bcast(one.data(), (int) one.size(), MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  EXPECT_EQ(two.size(), 3 * 320 + 1u);
+  EXPECT_LT(rel_rms(two, one), 1e-12);
+  EXPECT_NEAR(two.back(), one.back(), 1e-12 * std::fabs(one.back()));
+}
+
 // a periodic layer of charges above the electrode against LAMMPS's own Ewald with the slab
 // correction on the system with its images made explicit (atoms of charge -q at the mirror
 // points; the pair is neutral): the force on the real atoms is the same sum
