@@ -45,33 +45,11 @@ namespace ML = MarshallLanes;
 PairGranularOpt::PairGranularOpt(LAMMPS *lmp) :
     PairGranular(lmp), fused_ready(false), generic_only(true), all_fused(false), any_heat(false),
     sleep_fix(nullptr), active_build(-1), active_generation(-1), ncontacts(0), history_update(true),
-    hist_tangential(0), hist_rolling(0), hist_twisting(0), history_fresh(false),
-    history_fresh_checked(true)
+    hist_tangential(0), hist_rolling(0), hist_twisting(0), history_handover(lmp)
 {
 }
 
-/* ----------------------------------------------------------------------
-   The contact history of granular and granular/opt is one fix NEIGH_HISTORY with the same
-   per-pair values. LAMMPS names it NEIGH_HISTORY_GRANULAR<n> after the pair style's instance
-   (from 4Jul2026 on), and read_restart restores it only into a fix of the stored name: a restart
-   written by one style and read with the other (a new instance) would start every contact
-   afresh. So granular/opt takes over a stored history that no fix has claimed when it creates its
-   own, and, when it is deleted for a style given after read_restart, renames the stored history
-   for the instance created next. Modify keeps the stored entries in protected members; a
-   derived class may form pointers to them.
-------------------------------------------------------------------------- */
-
 namespace {
-struct StoredFixData : Modify {
-  static char **Modify::*ids() { return &StoredFixData::id_restart_peratom; }
-  static char **Modify::*styles() { return &StoredFixData::style_restart_peratom; }
-  static int *Modify::*used() { return &StoredFixData::used_restart_peratom; }
-};
-// the number of contacts (partners) a history holds for each local atom after a run
-struct HistoryPartners : FixNeighHistory {
-  static int *FixNeighHistory::*count() { return &HistoryPartners::npartner; }
-};
-
 // a per-atom 3-vector array of Atom (memory->create: row i at [0] + 3 i) indexed without its row
 // pointers: one dependent load less for each atom a contact touches
 struct AtomRows {
@@ -79,120 +57,22 @@ struct AtomRows {
   explicit AtomRows(double **rows) : first(rows ? rows[0] : nullptr) {}
   double *operator[](int i) const { return first + 3 * static_cast<std::ptrdiff_t>(i); }
 };
-
-// the stored histories of pair styles granular and granular/opt no fix has taken
-[[maybe_unused]] std::vector<int> unclaimed_histories(Modify *modify)
-{
-  std::vector<int> found;
-  char **ids = modify->*StoredFixData::ids();
-  char **styles = modify->*StoredFixData::styles();
-  int *used = modify->*StoredFixData::used();
-  for (int k = 0; k < modify->nfix_restart_peratom; k++)
-    if (!used[k] && strcmp(styles[k], "NEIGH_HISTORY") == 0 &&
-        utils::strmatch(ids[k], "^NEIGH_HISTORY_GRANULAR\\d*$") && !modify->get_fix_by_id(ids[k]))
-      found.push_back(k);
-  return found;
-}
-
-// was fix `id` given its values by the restart file just read (even an empty history)?
-bool restored_from_restart(Modify *modify, const char *id)
-{
-  char **ids = modify->*StoredFixData::ids();
-  int *used = modify->*StoredFixData::used();
-  for (int k = 0; k < modify->nfix_restart_peratom; k++)
-    if (used[k] && strcmp(ids[k], id) == 0) return true;
-  return false;
-}
-
-bigint history_contacts(LAMMPS *lmp, FixNeighHistory *history)
-{
-  const int *count = history->*HistoryPartners::count();
-  bigint mine = 0;
-  for (int i = 0; count && i < lmp->atom->nlocal; i++) mine += count[i];
-  bigint all = 0;
-  MPI_Allreduce(&mine, &all, 1, MPI_LMP_BIGINT, MPI_SUM, lmp->world);
-  return all;
-}
 }    // namespace
 
 PairGranularOpt::~PairGranularOpt()
 {
-  // LAMMPS deletes update before the pair style at its end: then nothing follows this style
-  if (!update) return;
-  if (fix_history) {
-    const bigint lost = history_contacts(lmp, fix_history);
-    if (lost > 0 && comm->me == 0)
-      error->warning(FLERR,
-                     "Pair granular/opt deleted with {} contacts in its history: a pair style "
-                     "defined now starts them afresh (no tangential, rolling or twisting spring, "
-                     "no JKR branch); write_restart, then read_restart and the other style, "
-                     "keeps them",
-                     lost);
-    return;
-  }
-#if GC_LAMMPS_VERSION >= 20260704
-  const auto stored = unclaimed_histories(modify);
-  if (stored.size() == 1) {
-    char *&id = (modify->*StoredFixData::ids())[stored.front()];
-    delete[] id;
-    id = utils::strdup("NEIGH_HISTORY_GRANULAR" + std::to_string(Pair::instance_total));
-  }
-#endif
-}
-
-/* ----------------------------------------------------------------------
-   before the history fix is created: take over the one stored history no fix has claimed if
-   none has this style's name (see the destructor)
-------------------------------------------------------------------------- */
-
-void PairGranularOpt::adopt_restart_history()
-{
-#if GC_LAMMPS_VERSION >= 20260704
-  const auto stored = unclaimed_histories(modify);
-  char **ids = modify->*StoredFixData::ids();
-  for (int k : stored)
-    if (strcmp(ids[k], id_history) == 0) return;
-  if (stored.size() > 1)
-    error->warning(FLERR, "Pair granular/opt: {} contact histories in the restart file, none "
-                   "of this style's name {}: it starts with none", stored.size(), id_history);
-  if (stored.size() != 1) return;
-  delete[] id_history;
-  id_history = utils::strdup(ids[stored.front()]);
-#endif
-}
-
-/* ----------------------------------------------------------------------
-   a history created empty after step 0 on touching pairs (a switch from pair_style granular
-   within one input, or a bed read from a dump): every contact starts afresh, which is a
-   different answer from a run that kept its contacts; say so once
-------------------------------------------------------------------------- */
-
-void PairGranularOpt::warn_fresh_history()
-{
-  history_fresh_checked = true;
-  if (!history_fresh || update->ntimestep == 0) return;
-  bigint mine = static_cast<bigint>(contacts.size()), touching = 0;
-  MPI_Allreduce(&mine, &touching, 1, MPI_LMP_BIGINT, MPI_SUM, world);
-  if (touching > 0 && comm->me == 0)
-    error->warning(FLERR,
-                   "Pair granular/opt starts at step {} with {} touching pairs and no contact "
-                   "history: each starts afresh (no tangential, rolling or twisting spring, the "
-                   "JKR loading branch). A switch from pair_style granular within one input "
-                   "loses the history; a restart read with granular/opt keeps it",
-                   update->ntimestep, touching);
+  history_handover.pair_deleted(fix_history);
 }
 
 /* ---------------------------------------------------------------------- */
 
 void PairGranularOpt::init_style()
 {
+  // the contact history across restarts and switches of style (granular_history_handover.h)
   const bool first_init = fix_history == nullptr;
-  if (first_init) adopt_restart_history();
+  if (first_init) history_handover.adopt_stored_history(id_history);
   PairGranular::init_style();
-  if (first_init && fix_history) {
-    history_fresh = !restored_from_restart(modify, fix_history->id);
-    history_fresh_checked = false;
-  }
+  if (first_init) history_handover.history_created(fix_history);
   fused_ready = false;    // init_one() may still mix new models: set up before the first compute
   auto sleepers = modify->get_fix_by_style("^sleep/gran$");
   sleep_fix = sleepers.empty() ? nullptr : sleepers.front();
@@ -289,7 +169,8 @@ void PairGranularOpt::compute(int eflag, int vflag)
   }
   begin_step(eflag, vflag);
   gather_contacts();
-  if (!history_fresh_checked) warn_fresh_history();
+  if (history_handover.check_pending())
+    history_handover.check_fresh_history(static_cast<bigint>(contacts.size()));
   const bigint generic_contacts = generic_i.empty() ? 0 : compute_generic_pairs(eflag, vflag);
   jkr_root.resize(jkr_overlap.size());
   JKRScaled::roots(jkr_overlap.size(), jkr_overlap.data(), jkr_root.data());
