@@ -403,8 +403,8 @@ void PairGranularOpt::compute_fused_contacts()
   lane_out.resize(CHUNK * ML::N_OUTPUT);
   lane_of.resize(CHUNK);
   // lane l's first input and output: block l / W, offset l % W, WIDTH apart
-  auto lane_input = [&](int l) { return &lane_in[(l / W) * ML::N_INPUT * W + l % W]; };
-  auto lane_output = [&](int l) { return &lane_out[(l / W) * ML::N_OUTPUT * W + l % W]; };
+  auto lane_input = [&](int l) { return ML::lane_input(lane_in.data(), l); };
+  auto lane_output = [&](int l) { return ML::lane_output(lane_out.data(), l); };
 
   const AtomRows v(atom->v), omega(atom->omega), f(atom->f), torque(atom->torque);
   const double *radius = atom->radius, *rmass = atom->rmass;
@@ -463,6 +463,7 @@ void PairGranularOpt::compute_fused_contacts()
     put(ML::TWISTING, fm.twisting ? 1.0 : 0.0);
     put(ML::HERTZ, fm.gamma == 0.0 ? 1.0 : 0.0);
     put(ML::EMIX, fm.emix);
+    put(ML::LEVER_SHIFT, ML::LEVER_SHIFT_PAIR);
   };
   auto gather_contact = [&](const Contact &c, double s, double *in, int stride) {
     gather_own(c, s, in, stride);
@@ -556,12 +557,7 @@ void PairGranularOpt::compute_fused_contacts()
       nlanes++;
     }
     // a short last block: its other lanes evaluate copies of its first contact, not scattered
-    const int nblocks = (nlanes + W - 1) / W;
-    for (int l = nlanes; l < nblocks * W; l++) {
-      const double *first = lane_input(l - l % W);
-      double *pad = lane_input(l);
-      for (int q = 0; q < ML::N_INPUT; q++) pad[q * W] = first[q * W];
-    }
+    const std::size_t nblocks = ML::pad_last_block(lane_in.data(), nlanes);
     ML::contacts_in_lanes(nblocks, lane_in.data(), lane_out.data(), history_update);
 
     for (std::size_t k = 0; k < m; k++) {
