@@ -322,10 +322,44 @@ void PairGranularOpt::gather_contacts()
 
 /* ----------------------------------------------------------------------
    the pairs outside the fused set by PairGranular::compute itself, on a neighbor list (and
-   contact flags and histories) holding only them; their flags and histories are copied back
+   contact flags and histories) holding only them; their flags and histories are copied back.
+   Returns the number of those pairs that touch.
 ------------------------------------------------------------------------- */
 
 bigint PairGranularOpt::compute_generic_pairs(int eflag, int vflag)
+{
+  build_generic_list();
+  NeighList *full = list;
+  int **flags = use_history ? fix_history->firstflag : nullptr;
+  double **values = use_history ? fix_history->firstvalue : nullptr;
+  list = generic_list.get();
+  if (use_history) {
+    fix_history->firstflag = generic_firsttouch.data();
+    fix_history->firstvalue = generic_firsthistory.data();
+  }
+  PairGranular::compute(eflag, vflag);
+  list = full;
+  if (!use_history) return 0;
+  fix_history->firstflag = flags;
+  fix_history->firstvalue = values;
+  const int size_hist = get_size_history();
+  bigint touching = 0;
+  for (size_t k = 0; k < generic_i.size(); k++) {
+    const int i = generic_i[k], jj = generic_jj[k];
+    flags[i][jj] = generic_touch[k];
+    touching += generic_touch[k] != 0;
+    std::copy(&generic_history[size_hist * k], &generic_history[size_hist * (k + 1)],
+              &values[i][size_hist * jj]);
+  }
+  return touching;
+}
+
+/* ----------------------------------------------------------------------
+   the neighbor list of the pairs outside the fused set (generic_i, generic_jj) with copies of
+   their contact flags and histories: arrays of this style, in the layout of the full list's
+------------------------------------------------------------------------- */
+
+void PairGranularOpt::build_generic_list()
 {
   const int nall = atom->nlocal + atom->nghost;
   const int size_hist = use_history ? get_size_history() : 0;
@@ -360,29 +394,6 @@ bigint PairGranularOpt::compute_generic_pairs(int eflag, int vflag)
   generic_list->ilist = generic_atoms.data();
   generic_list->numneigh = generic_numneigh.data();
   generic_list->firstneigh = generic_firstneigh.data();
-
-  NeighList *full = list;
-  int **flags = use_history ? fix_history->firstflag : nullptr;
-  double **values = use_history ? fix_history->firstvalue : nullptr;
-  list = generic_list.get();
-  if (use_history) {
-    fix_history->firstflag = generic_firsttouch.data();
-    fix_history->firstvalue = generic_firsthistory.data();
-  }
-  PairGranular::compute(eflag, vflag);
-  list = full;
-  if (!use_history) return 0;
-  fix_history->firstflag = flags;
-  fix_history->firstvalue = values;
-  bigint touching = 0;
-  for (size_t k = 0; k < n; k++) {
-    const int i = generic_i[k], jj = generic_jj[k];
-    flags[i][jj] = generic_touch[k];
-    touching += generic_touch[k] != 0;
-    std::copy(&generic_history[size_hist * k], &generic_history[size_hist * (k + 1)],
-              &values[i][size_hist * jj]);
-  }
-  return touching;
 }
 
 /* ----------------------------------------------------------------------

@@ -119,6 +119,7 @@ class PairGranularOpt : public PairGranular {
   void type_scales();
   void gather_contacts();
   bigint compute_generic_pairs(int eflag, int vflag);
+  void build_generic_list();
   void compute_fused_contacts();
   int scales_of(int i, int j, const FusedMarshall &fm);
 };
