@@ -41,7 +41,7 @@ struct HistoryPartners : FixNeighHistory {
 };
 
 // the stored histories of pair styles granular and granular/opt no fix has taken
-[[maybe_unused]] std::vector<int> unclaimed_histories(Modify *modify)
+std::vector<int> unclaimed_histories(Modify *modify)
 {
   std::vector<int> found;
   char **ids = modify->*StoredFixData::ids();
@@ -79,7 +79,6 @@ bigint history_contacts(LAMMPS *lmp, FixNeighHistory *history)
 
 void GranularHistoryHandover::adopt_stored_history(char *&id_history)
 {
-#if GC_LAMMPS_VERSION >= 20260704
   const auto stored = unclaimed_histories(modify);
   char **ids = modify->*StoredFixData::ids();
   for (int k : stored)
@@ -90,9 +89,6 @@ void GranularHistoryHandover::adopt_stored_history(char *&id_history)
   if (stored.size() != 1) return;
   delete[] id_history;
   id_history = utils::strdup(ids[stored.front()]);
-#else
-  (void) id_history;
-#endif
 }
 
 /* ---------------------------------------------------------------------- */

@@ -30,8 +30,9 @@ class GranularHistoryHandover : protected Pointers {
  public:
   explicit GranularHistoryHandover(LAMMPS *lmp) : Pointers(lmp) {}
 
-  // before the pair's first init_style() creates its history fix named id_history: takes over
-  // the one stored history no fix has claimed if none has that name (id_history renamed)
+  // before the pair's first init_style() creates its history fix named id_history (LAMMPS
+  // 4Jul2026 on: one name per pair style instance): takes over the one stored history no fix
+  // has claimed if none has that name (id_history renamed)
   void adopt_stored_history(char *&id_history);
   // after that first init_style(): notes whether the fix created started empty
   void history_created(const FixNeighHistory *history);

@@ -70,7 +70,9 @@ void PairGranularOpt::init_style()
 {
   // the contact history across restarts and switches of style (granular_history_handover.h)
   const bool first_init = fix_history == nullptr;
-  if (first_init) history_handover.adopt_stored_history(id_history);
+#if GC_LAMMPS_VERSION >= 20260704
+  if (first_init) history_handover.adopt_stored_history(id_history);    // named per instance
+#endif
   PairGranular::init_style();
   if (first_init) history_handover.history_created(fix_history);
   fused_ready = false;    // init_one() may still mix new models: set up before the first compute
