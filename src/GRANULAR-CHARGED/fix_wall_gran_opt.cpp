@@ -12,10 +12,8 @@
 #include "atom.h"
 #include "comm.h"
 #include "domain.h"
-#include "gran_sub_mod.h"
 #include "granular_model.h"
 #include "marshall_lanes.h"
-#include "math_extra.h"
 #include "update.h"
 
 #if GC_LAMMPS_VERSION >= 20260704
@@ -28,7 +26,6 @@
 
 using namespace LAMMPS_NS;
 using namespace Granular_NS;
-using namespace MathExtra;
 namespace MK = MarshallKernels;
 
 // FixWallGran's wall styles (fix_wall_gran.cpp: "XYZ PLANE need to be 0,1,2") and its value of

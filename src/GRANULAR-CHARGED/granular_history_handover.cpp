@@ -106,7 +106,7 @@ void GranularHistoryHandover::history_created(const FixNeighHistory *history)
    different answer from a run that kept its contacts; say so once
 ------------------------------------------------------------------------- */
 
-void GranularHistoryHandover::check_fresh_history(bigint touching)
+void GranularHistoryHandover::warn_fresh_history(bigint touching)
 {
   fresh_checked = true;
   if (!fresh || update->ntimestep == 0) return;

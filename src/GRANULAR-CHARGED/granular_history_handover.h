@@ -36,14 +36,18 @@ class GranularHistoryHandover : protected Pointers {
   void adopt_stored_history(char *&id_history);
   // after that first init_style(): notes whether the fix created started empty
   void history_created(const FixNeighHistory *history);
-  // on the pair's first compute() after history_created(): warns once if an empty history
-  // meets touching pairs after step 0 (touching: those of this rank)
-  bool check_pending() const { return !fresh_checked; }
-  void check_fresh_history(bigint touching);
+  // from the pair's compute(): on the first after history_created(), warns if the history
+  // started empty and meets touching pairs after step 0 (touching: those of this rank)
+  void check_fresh_history(bigint touching)
+  {
+    if (!fresh_checked) warn_fresh_history(touching);
+  }
   // from the pair's destructor (history: its fix, or null if it never made one)
   void pair_deleted(FixNeighHistory *history);
 
  private:
+  void warn_fresh_history(bigint touching);
+
   bool fresh = false;            // the history fix was created empty by the pair's first init
   bool fresh_checked = true;     // the touching pairs of a fresh history were counted
 };

@@ -12,7 +12,6 @@
 #include "marshall_lanes.h"
 
 #include "atom.h"
-#include "comm.h"
 #include "error.h"
 #include "fix.h"
 #include "fix_charge_check.h"
@@ -20,14 +19,11 @@
 #include "force.h"
 #include "gran_sub_mod.h"
 #include "granular_model.h"
-#include "kspace.h"
 #include "math_extra.h"
-#include "memory.h"
 #include "modify.h"
 #include "neigh_list.h"
 #include "neighbor.h"
 #include "update.h"
-#include "utils.h"
 
 #include <cstddef>
 #include <cmath>
@@ -128,22 +124,20 @@ bool PairGranularOpt::model_is_fused(int n) const
 void PairGranularOpt::setup_fused()
 {
   fused.assign(nmodels, FusedMarshall());
+  bool any_fused = false;
+  all_fused = true;
+  any_heat = false;
   for (int n = 0; n < nmodels; n++) {
     FusedMarshall &f = fused[n];
-    if (!MarshallFusedSet::of_model(models_list[n], f)) continue;
-    f.on = true;
+    f.on = MarshallFusedSet::of_model(models_list[n], f);
+    any_fused = any_fused || f.on;
+    all_fused = all_fused && f.on;
+    // a heat model needs PairGranular's heat-flow bookkeeping, which the fused loop does not do
+    any_heat = any_heat || models_list[n]->sub_models[HEAT]->name != "none";
+    if (!f.on) continue;
     hist_tangential = f.hist_tangential;
     hist_rolling = f.hist_rolling;
     hist_twisting = f.hist_twisting;
-  }
-  // a heat model needs PairGranular's heat-flow bookkeeping, which the fused loop does not do
-  bool any_fused = false;
-  any_heat = false;
-  all_fused = true;
-  for (int n = 0; n < nmodels; n++) {
-    any_fused = any_fused || fused[n].on;
-    all_fused = all_fused && fused[n].on;
-    any_heat = any_heat || models_list[n]->sub_models[HEAT]->name != "none";
   }
   generic_only = !any_fused || any_heat;
   fused_ready = true;
@@ -171,8 +165,7 @@ void PairGranularOpt::compute(int eflag, int vflag)
   }
   begin_step(eflag, vflag);
   gather_contacts();
-  if (history_handover.check_pending())
-    history_handover.check_fresh_history(static_cast<bigint>(contacts.size()));
+  history_handover.check_fresh_history(static_cast<bigint>(contacts.size()));
   const bigint generic_contacts = generic_i.empty() ? 0 : compute_generic_pairs(eflag, vflag);
   jkr_root.resize(jkr_overlap.size());
   JKRScaled::roots(jkr_overlap.size(), jkr_overlap.data(), jkr_root.data());
