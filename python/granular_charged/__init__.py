@@ -3,9 +3,11 @@ sweep parameters, analyse packings and draw the figures of Chen, Li, Liu & Makse
 2016).
 
 Command line: ``granular-charged`` (or ``python3 -m granular_charged``), see doc/python.md.
-Subpackages:
+Subpackages, each importing only those listed after it, and ``studies`` and ``figures``
+not each other (doc/python.md, "Package layout"):
 
-- ``cli``: the command line's subcommands (only ``__main__`` imports it);
+- ``cli``: the command line's subcommands, which draw the studies' figures (only ``__main__``
+  imports it);
 - ``studies``: many runs (sweeps, study files, demo, reproduce) and the Snakemake engine;
 - ``figures``: the paper's figures and the studies' figures;
 - ``run``: one run (the LAMMPS build, the decks and their variables, populations, the child

@@ -9,6 +9,7 @@ from __future__ import annotations
 # Table 2, "Packing structures when charged after formation" (r_p = 2 um, U_0 = 1 m/s,
 # gamma = 10 mJ/m^2; N = 2000, L = 28 r_p): charge q [e_0], phi, <Z>
 TABLE2 = ((0.0, 0.3249, 3.2056), (260.0, 0.3248, 3.2056), (400.0, 0.3247, 3.2056))
+TABLE2_CASE = (2.0, 1.0)          # its (r_p [um], U_0 [m/s]), also the case of Fig. 2
 # Sec. 3: "The volume fraction for packings of neutral particles phi_0 ranges from 0.270 to 0.363"
 PHI0_RANGE = (0.270, 0.363)
 # Sec. 3: "a line with a slope of two nicely describe ... phi_0/phi - 1" (log-log vs q)

@@ -8,6 +8,7 @@ import pytest
 from granular_charged import paper
 from granular_charged.params import DepositionParams
 from granular_charged.analysis import measures
+from granular_charged.analysis.conventions import case_table, run_frame
 from granular_charged.figures.conventions import phi0_question
 from granular_charged.studies import conventions
 from granular_charged.studies.reproduce import paper_size_params
@@ -60,7 +61,7 @@ def test_case_means_and_the_three_checks(tmp_path):
     rs = _study(tmp_path, 0.04, paper.TABLE2[0][1], 3.6056, (0.30, 0.34), 0.27, Z_all_shift=0.4)
     # theta 0.01: the deck's, 30% denser: nothing passes
     rs += _study(tmp_path, 0.01, 0.417, 3.93, (0.337, 0.454), 0.351)
-    t = conventions.case_table(conventions.run_frame(rs))
+    t = case_table(run_frame(rs))
     assert len(t) == 8 and (t["runs"] == 3).all()
     r = t[(t["theta_crit"] == 0.04) & (t["q"] == 0) & (t["rp_um"] == 2.0)].iloc[0]
     assert r["phi"] == pytest.approx(0.3249) and r["phi_sd"] == pytest.approx(0.002)
@@ -94,7 +95,7 @@ def test_tolerances_at_their_edges(tmp_path):
     s = 0.01 * np.sqrt(4 / 3)
     rs = _study(tmp_path, 0.02, paper.TABLE2[0][1] + 1.9 * s, 3.2056, (0.27 - 2.1 * s, 0.34),
                 0.25, spread=0.01)
-    c = conventions.checks(conventions.case_table(conventions.run_frame(rs))).set_index(
+    c = conventions.checks(case_table(run_frame(rs))).set_index(
         ["theta_crit", "phi_definition", "Z_definition"])
     row = c.loc[(0.02, "slab", "slab")]
     assert row["phi0_dev"] == pytest.approx(1.9) and row["table2_ok"] == 1
@@ -103,7 +104,7 @@ def test_tolerances_at_their_edges(tmp_path):
     # an expansion above 0.40 by more than 2 standard errors fails the charge check
     (tmp_path / "x").mkdir()
     rs = _study(tmp_path / "x", 0.01, 0.40, 3.2, (0.30, 0.34), 0.25)
-    c = conventions.checks(conventions.case_table(conventions.run_frame(rs))).set_index(
+    c = conventions.checks(case_table(run_frame(rs))).set_index(
         ["theta_crit", "phi_definition", "Z_definition"])
     row = c.loc[(0.01, "slab", "slab")]
     assert row["expansion"] == pytest.approx(0.6) and row["charge_ok"] == 0
@@ -111,7 +112,7 @@ def test_tolerances_at_their_edges(tmp_path):
     # the paper's looser charged packing
     (tmp_path / "y").mkdir()
     rs = _study(tmp_path / "y", 0.01, 0.325, 3.2, (0.30, 0.34), 0.324, spread=0.01)
-    row = conventions.checks(conventions.case_table(conventions.run_frame(rs))).set_index(
+    row = conventions.checks(case_table(run_frame(rs))).set_index(
         ["theta_crit", "phi_definition", "Z_definition"]).loc[(0.01, "slab", "slab")]
     assert 0 < row["expansion"] < row["expansion_se"] and row["charge_ok"] == 0
     assert row["table2_ok"] == 1 and row["range_ok"] == 1 and row["all_ok"] == 0

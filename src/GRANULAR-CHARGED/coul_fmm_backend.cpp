@@ -25,6 +25,7 @@
 #include "gcfmm/options.hpp"
 
 #include <exception>
+#include <utility>
 
 using namespace LAMMPS_NS;
 
@@ -43,17 +44,23 @@ bool CoulFMMBackend::create(Kind k, const gcfmm::Options &opts, bool dipoles)
   kind = k;
   boundary = (int) opts.boundary;
   backend.reset();
+  // the one sum over the ranks of the solvers that every rank runs on all atoms: each rank
+  // computes its share of the work, the sum completes it (each value comes from one rank: the
+  // same result as on one rank)
+  const gcfmm::PartSum sum = [this](double *data, std::size_t count) {
+    mpi.collectives.allreduce_sum(data, count);
+  };
   try {
     if (kind == Kind::DISTRIBUTED) {
       backend = std::make_unique<gcfmm::DistributedBackend>(opts, mpi.collectives);
     } else if (kind == Kind::POLARIZABLE) {
-      backend = std::make_unique<gcfmm::PolarizableBackend>(opts, dipoles);
+      auto polar = std::make_unique<gcfmm::PolarizableBackend>(opts, dipoles);
+      // each rank its share of the targets of every FMM evaluation
+      if (comm->nprocs > 1) polar->solver().set_partition(comm->me, comm->nprocs, sum);
+      backend = std::move(polar);
     } else {
       // the ranks share the far field's anterpolation, which every one of them would
-      // otherwise repeat: each computes its share, one in-place sum completes it (exact)
-      const gcfmm::PartSum sum = [this](double *data, std::size_t count) {
-        mpi.collectives.allreduce_sum(data, count);
-      };
+      // otherwise repeat
       backend = std::make_unique<gcfmm::ReplicatedBackend>(opts, comm->me, comm->nprocs, sum);
     }
   } catch (std::exception &e) {
@@ -135,20 +142,22 @@ void CoulFMMBackend::check_counted_once(Fix *self)
   }
 }
 
-CoulFMMBackend::Cell CoulFMMBackend::cell() const
+CoulFMMCell CoulFMMBackend::cell() const
 {
-  return {domain->boxlo[0], domain->boxlo[1], domain->xprd,
-          domain->yprd,     domain->boxlo[2], domain->boxhi[2]};
-}
-
-bool CoulFMMBackend::periodic_box() const
-{
-  return domain->xperiodic && domain->yperiodic;
+  CoulFMMCell c;
+  c.periodic = domain->xperiodic && domain->yperiodic;
+  c.xlo = domain->boxlo[0];
+  c.ylo = domain->boxlo[1];
+  c.lx = domain->xprd;
+  c.ly = domain->yprd;
+  c.zlo = domain->boxlo[2];
+  c.zhi = domain->boxhi[2];
+  return c;
 }
 
 void CoulFMMBackend::set_cell()
 {
-  set_cell_of(*backend);
+  cell().apply_to(*backend);
 }
 
 double CoulFMMBackend::scale() const

@@ -15,6 +15,7 @@
 #ifndef LMP_COUL_FMM_BACKEND_H
 #define LMP_COUL_FMM_BACKEND_H
 
+#include "coul_fmm_cell.h"
 #include "coul_fmm_comm.h"
 #include "pointers.h"
 
@@ -58,17 +59,9 @@ class CoulFMMBackend : protected Pointers {
   CoulFMMComm &communication() { return mpi; }
 
   // the primary cell and its z range from the LAMMPS box (boundary p p f; nothing in free
-  // space): to the solver, and to any other gcfmm object with set_box and set_z_range
+  // space): to the solver; cell() for any other gcfmm object (CoulFMMCell::apply_to)
   void set_cell();
-  template <class T> void set_cell_of(T &target) const
-  {
-    if (!periodic_box()) return;
-    const Cell c = cell();
-    target.set_box(c.xlo, c.ylo, c.lx, c.ly);
-    // boundary f in z keeps every atom in the box: one far-field set-up for the run instead of
-    // one each time the charges' z range grows (e.g. during a deposition)
-    target.set_z_range(c.zlo, c.zhi);
-  }
+  CoulFMMCell cell() const;
   // bare 1/r kernel -> LAMMPS units (qqrd2e includes the dielectric constant)
   double scale() const;
 
@@ -79,11 +72,6 @@ class CoulFMMBackend : protected Pointers {
            bool same_on_all_ranks, const std::function<std::string()> &explain = nullptr);
 
  private:
-  struct Cell {
-    double xlo, ylo, lx, ly, zlo, zhi;
-  };
-  Cell cell() const;
-  bool periodic_box() const;
   std::unique_ptr<gcfmm::CoulombBackend> backend;
   Kind kind;
   int boundary;

@@ -65,28 +65,33 @@ bool CoulFMMChargeScheme::continues()
   return p.state->continues(*p.stepping, eval->boundary(), [this](int i) { return eval->asleep(i); });
 }
 
-// evaluate on the schedule's steps, whenever atoms were added or removed (fix deposit,
-// evaporate: a new atom must feel, and exert, the force from its first step), whenever the
-// charges, qqrd2e or the geometry changed (a stored field would belong to other charges) and
-// when a pair refreshed since the evaluation is about to leave the neighbor lists or has left
-// them (CoulFMMNearRefresh::pair_leaving); a line search evaluates several trial positions within
-// one step: always (predict false)
-double CoulFMMChargeScheme::compute(bool predict)
+// due on the schedule's steps, whenever atoms were added or removed (fix deposit, evaporate:
+// a new atom must feel, and exert, the force from its first step) and whenever the charges,
+// qqrd2e or the geometry changed (a stored field would belong to other charges)
+bool CoulFMMChargeScheme::evaluation_due()
 {
-  if (!predict) {
-    compute_field(false);
-    return apply_field();
-  }
-  const bigint step = update->ntimestep;
   eval->update_sleepers();
-  bool due = p.stepping->scheduled(step) ||
+  return p.stepping->scheduled(update->ntimestep) ||
       p.state->continuity(*p.stepping, eval->boundary(), [this](int i) { return eval->asleep(i); }) !=
-          MTS::Continuity::SAME;
-  bool brought_forward = false;
-  if (!due && p.stepping->settings().every > 1 && !advance_field()) due = brought_forward = true;
-  if (due) compute_field(true, brought_forward);
+      MTS::Continuity::SAME;
+}
+
+// eq. (5.2); it cannot follow the atoms when a pair refreshed since the evaluation is about to
+// leave the neighbor lists or has left them (CoulFMMNearRefresh::pair_leaving). With every 1
+// the stored field is that of this step (a run continued on the step of its last evaluation).
+bool CoulFMMChargeScheme::continue_last(double &energy)
+{
+  if (p.stepping->settings().every > 1 && !advance_field()) return false;
   const int check = p.stepping->settings().check_every;
-  if (check > 0 && !due && step % check == 0) eval->measure_error(*p.stepping, *p.state);
+  if (check > 0 && update->ntimestep % check == 0) eval->measure_error(*p.stepping, *p.state);
+  energy = apply_field();
+  return true;
+}
+
+// a line search evaluates several trial positions within one step: a field of their own
+double CoulFMMChargeScheme::evaluate(Evaluation why)
+{
+  compute_field(why != Evaluation::FRESH, why == Evaluation::BROUGHT_FORWARD);
   return apply_field();
 }
 

@@ -27,16 +27,19 @@ class CoulFMMChargeScheme : public CoulFMMScheme, protected Pointers {
  public:
   CoulFMMChargeScheme(class LAMMPS *, const Parts &);
   ~CoulFMMChargeScheme() override;
-  CoulFMMEvaluator &evaluator() { return *eval; }
 
   void init() override;
   bool continues() override;
-  double compute(bool predict) override;
   bool acts_on(int i) const override;
   double total_energy(double atoms) override;
   const Diagnostics &diagnostics() const override;
   double evaluations() const override { return nevaluations; }
   double memory_usage() const override;
+
+ protected:
+  bool evaluation_due() override;
+  bool continue_last(double &energy) override;
+  double evaluate(Evaluation why) override;
 
  private:
   Parts p;

@@ -128,7 +128,7 @@ void CoulFMMEvaluator::evaluate(const Rows &out, bool split)
   if (split) {
     pair_energy = 0.0;    // a full evaluation (keyword check) keeps the split's
     // the same sleepers on every rank: a failure here is seen by all
-    backend.run([this] { sleepers->prepare(backend); },
+    backend.run([this] { sleepers->prepare(backend.cell()); },
                 [this](size_t k) { return sleepers->source_tag(k); }, true);
   }
   int *mask = atom->mask;

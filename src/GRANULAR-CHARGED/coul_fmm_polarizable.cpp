@@ -94,21 +94,29 @@ void CoulFMMPolarizable::check_combinations()
 }
 
 // F_i = q_i E_i + (p_i . grad) E_i and the energy of doc/polarization.md, eq. (3.4), evaluated
-// on the schedule's steps and continued between them (section 8)
-double CoulFMMPolarizable::compute(bool predict)
+// on the schedule's steps and continued between them (section 8); other atoms or charges, or
+// displacements too large for the periodic cell, are found by the continuation (advance)
+bool CoulFMMPolarizable::evaluation_due()
+{
+  return parts.stepping->scheduled(update->ntimestep);
+}
+
+bool CoulFMMPolarizable::continue_last(double &energy)
+{
+  return advance(parts.state->field_rows(), parts.state->force_rows(), energy);
+}
+
+// every evaluation of a run measures the continuation's error and adapts the interval to it
+double CoulFMMPolarizable::evaluate(Evaluation why)
 {
   CoulFMMTimeStepping &stepping = *parts.stepping;
   CoulFMMState &state = *parts.state;
-  const bigint step = update->ntimestep;
-  double energy = 0.0;
-  const bool continued = predict && !stepping.scheduled(step) &&
-      advance(state.field_rows(), state.force_rows(), energy);
-  if (continued) return energy;
-  energy = evaluate(state.field_rows(), state.force_rows(), predict, stepping.stride());
+  const bool predict = why != Evaluation::FRESH;
+  const double energy = solve(state.field_rows(), state.force_rows(), predict, stepping.stride());
   nevaluations += 1.0;
   if (predict) {
     if (prediction_error() >= 0.0) stepping.adapt(prediction_error());
-    stepping.evaluated.step = step;
+    stepping.evaluated.step = update->ntimestep;
   }
   return energy;
 }
@@ -151,12 +159,6 @@ void CoulFMMPolarizable::init_solver(const gcfmm::Options &opts)
   backend.create(CoulFMMBackend::Kind::POLARIZABLE, opts, s.polarize);
   gcfmm::PolarizableSolver &solver = backend.polarizable().solver();
   solver.set_induction(induction);
-  // every rank computes its share of the targets of each evaluation, one sum completes them
-  // (each value comes from one rank: the same result as on one rank)
-  if (comm->nprocs > 1)
-    solver.set_partition(comm->me, comm->nprocs, [this](double *data, std::size_t count) {
-      MPI_Allreduce(MPI_IN_PLACE, data, (int) count, MPI_DOUBLE, MPI_SUM, world);
-    });
   gcfmm::PolarizableEnvironment env;
   // LAMMPS field units (force = qe2f q E) -> bare units (force = qqrd2e q E_bare)
   const double to_bare = force->qe2f / force->qqrd2e;
@@ -216,7 +218,7 @@ void CoulFMMPolarizable::set_time_stepping(double cutoff, bool measure_error, bo
 // the last evaluation's atoms, with the same charges, continued to their positions now: `then`
 // is where each was at the evaluation, unwrapped alike (now minus its displacement, the
 // nearest periodic copy of it), so that every pair keeps its copy from then to now
-bool CoulFMMPolarizable::continue_last(gcfmm::NearChange &change, const std::vector<size_t> &targets)
+bool CoulFMMPolarizable::near_change(gcfmm::NearChange &change, const std::vector<size_t> &targets)
 {
   const size_t n = gathered.size();
   if (eval.tag.empty() || eval.tag != gathered.tag || eval.q != gathered.q) return false;
@@ -288,12 +290,12 @@ bool CoulFMMPolarizable::advance(double **field, double **force_out, double &ene
   gather();
   map_local();
   gcfmm::NearChange change;
-  if (!continue_last(change, local_k)) return false;
+  if (!near_change(change, local_k)) return false;
   energy = store(field, force_out, &change, extrapolate ? (double) (update->ntimestep - eval.step) : 0.0);
   return true;
 }
 
-double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool predict, int stride)
+double CoulFMMPolarizable::solve(double **field, double **force_out, bool predict, int stride)
 {
   parts.state->check_charges(parts.fix->id);
   gather();
@@ -310,7 +312,7 @@ double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool pre
     gcfmm::NearChange change;
     all_k.resize(n);
     std::iota(all_k.begin(), all_k.end(), size_t(0));
-    if (continue_last(change, all_k)) {
+    if (near_change(change, all_k)) {
       held.resize(3 * n);
       for (size_t k = 0; k < 3 * n; k++) held[k] = eval.force[k] + change.force[k];
     }
@@ -360,8 +362,6 @@ double CoulFMMPolarizable::evaluate(double **field, double **force_out, bool pre
   for (size_t k = 0; k < n; k++)
     for (int a = 0; a < 3; a++) eval.field[3 * k + a] = e3[a * n + k];
   const gcfmm::BackendStats rep = backend.solver().stats();
-  last_iterations = rep.iterations;
-  last_residual = rep.residual;
   diag.estimated_error = rep.estimated_error;
   diag.order = rep.order;
   diag.m2l = rep.m2l;

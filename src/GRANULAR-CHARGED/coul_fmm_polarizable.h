@@ -55,14 +55,20 @@ class CoulFMMPolarizable : public CoulFMMScheme, protected Pointers {
   ~CoulFMMPolarizable() override;
 
   // CoulFMMScheme: evaluations on the schedule's steps, continued in between (advance)
-  // (doc/polarization.md, section 8); a minimizer's call always evaluates
+  // (doc/polarization.md, section 8)
   void init() override;
   bool continues() override { return false; }    // an evaluation at every setup
-  double compute(bool predict) override;
   bool acts_on(int i) const override;
   const Diagnostics &diagnostics() const override { return diag; }
   double evaluations() const override { return nevaluations; }
+  double memory_usage() const override;
 
+ protected:
+  bool evaluation_due() override;
+  bool continue_last(double &energy) override;
+  double evaluate(Evaluation why) override;
+
+ private:
   // field[i][0..3] = Ex, Ey, Ez (applied field included) and the potential of the charges;
   // field[i][4..6] = the dipole (charge x distance; polarize only); force[i][0..2] = q E + (p . grad) E, all in
   // LAMMPS units, zero outside the group; returns this rank's part of the energy
@@ -70,26 +76,20 @@ class CoulFMMPolarizable : public CoulFMMScheme, protected Pointers {
   // two steps before this one (false: from the last solution; e.g. in a minimization)
   // stride: the time stepping's interval now (a trend of the far part is taken only over at
   // least that many steps)
-  double evaluate(double **field, double **force, bool predict = true, int stride = 1);
+  double solve(double **field, double **force, bool predict, int stride);
   // the same outputs from the last evaluation continued to the atoms now (its values plus the
   // near pairs' change within `cutoff` since then, dipoles held; the far part held). False
   // (nothing written) when it cannot be continued: no evaluation yet, other atoms or charges,
   // or displacements too large for the periodic cell; the caller then evaluates.
   bool advance(double **field, double **force, double &energy);
-  // the near cutoff of advance() (0: only the evaluation's values, held), whether evaluate()
+  // the near cutoff of advance() (0: only the evaluation's values, held), whether solve()
   // measures the error of the continued forces (the multiple time stepping is on), and whether
   // the far part of the force follows its trend over the last interval (extrapolate)
   void set_time_stepping(double cutoff, bool measure, bool extrapolate);
-  // relative RMS difference of the continued forces from those of the last evaluate() (over
+  // relative RMS difference of the continued forces from those of the last solve() (over
   // the group's charged and polarizable atoms); -1 if that evaluation continued nothing
   double prediction_error() const { return last_prediction_error; }
 
-  int iterations() const { return last_iterations; }
-  double residual() const { return last_residual; }
-  const Settings &settings() const { return s; }
-  double memory_usage() const override;
-
- private:
   Settings s;
   Parts parts;
   int groupbit;
@@ -110,11 +110,9 @@ class CoulFMMPolarizable : public CoulFMMScheme, protected Pointers {
   std::vector<tagint> last_tag, prev_tag;
   std::vector<double> last_p, prev_p;
   bigint last_step = -1, prev_step = -1;
-  int last_iterations = 0;
-  double last_residual = 0.0;
 
   // the last evaluation, in the gathered order (bare units; positions interleaved, 3 per atom)
-  struct Evaluation {
+  struct LastEvaluation {
     std::vector<tagint> tag;
     std::vector<double> x, q, p, field, force, energy;
     std::vector<double> slope;    // trend of the far part of the force per step (eq. (8.3))
@@ -134,7 +132,7 @@ class CoulFMMPolarizable : public CoulFMMScheme, protected Pointers {
 
   void gather();
   void map_local();
-  bool continue_last(gcfmm::NearChange &change, const std::vector<size_t> &targets);
+  bool near_change(gcfmm::NearChange &change, const std::vector<size_t> &targets);
   double store(double **field, double **force, const gcfmm::NearChange *change, double steps);
   std::string below_electrode() const;
 };

@@ -11,6 +11,14 @@
 // multiple time stepping (CoulFMMChargeScheme) or charges with an applied field, induced
 // dipoles and an electrode (CoulFMMPolarizable). The fix holds one and calls it on the LAMMPS
 // hooks; both write their fields and forces into the fix's CoulFMMState.
+//
+// Both continue the field between full evaluations by one rule, compute(): a minimizer's trial
+// positions are evaluated afresh; otherwise the last evaluation is continued to the atoms now
+// unless an evaluation is due or the continuation cannot follow the atoms. What is continued,
+// and how, is each scheme's own: the charges' field (far part extrapolated, near pairs refreshed
+// over the neighbor lists, doc/theory.md, section 5), or the forces of charges and dipoles with
+// the dipoles held (near pairs' change over the gathered atoms, doc/polarization.md, section 8;
+// the dipoles follow the field, so they cannot share the charges' field continuation).
 
 #ifndef LMP_COUL_FMM_SCHEME_H
 #define LMP_COUL_FMM_SCHEME_H
@@ -59,8 +67,16 @@ class CoulFMMScheme {
   // at a run's setup: the stored state continues (else the schedule starts again)
   virtual bool continues() = 0;
   // the forces of this step (CoulFMMState::force) and the fields; predict false: a minimizer's
-  // trial positions (a fresh evaluation, nothing continued). Returns this rank's energy.
-  virtual double compute(bool predict) = 0;
+  // trial positions (a fresh evaluation, nothing continued, whatever the keyword every).
+  // Returns this rank's energy.
+  double compute(bool predict)
+  {
+    if (!predict) return evaluate(Evaluation::FRESH);
+    if (evaluation_due()) return evaluate(Evaluation::SCHEDULED);
+    double energy = 0.0;
+    if (continue_last(energy)) return energy;
+    return evaluate(Evaluation::BROUGHT_FORWARD);
+  }
   // atom i (local) receives a force
   virtual bool acts_on(int i) const = 0;
   // the energy of all atoms (the ranks' sums of compute()) plus what no atom's force carries
@@ -69,6 +85,21 @@ class CoulFMMScheme {
   virtual const Diagnostics &diagnostics() const = 0;
   virtual double evaluations() const = 0;
   virtual double memory_usage() const = 0;
+
+ protected:
+  // why a full evaluation is made: a minimizer's trial positions (nothing continued, nothing
+  // adapted), the schedule (or other atoms or charges), or a continuation that cannot follow
+  // the atoms (brought forward: its span is shorter than the interval)
+  enum class Evaluation { FRESH, SCHEDULED, BROUGHT_FORWARD };
+  // an evaluation is due on this step: the schedule's steps, and whenever the last one no
+  // longer belongs to these atoms and charges
+  virtual bool evaluation_due() = 0;
+  // the last evaluation continued to the atoms now, its forces and fields written and this
+  // rank's energy in `energy`; false (nothing applied) when it cannot follow them (every rank
+  // answers the same)
+  virtual bool continue_last(double &energy) = 0;
+  // a full evaluation, its forces and fields written; returns this rank's energy
+  virtual double evaluate(Evaluation why) = 0;
 };
 
 }    // namespace LAMMPS_NS

@@ -9,18 +9,14 @@
 
 #include "coul_fmm_sleepers.h"
 
-#include "coul_fmm_backend.h"
-
 #include "coul_fmm_comm.h"
 
 #include "atom.h"
 #include "comm.h"
-#include "domain.h"
 
 #include "gcfmm/options.hpp"
 #include "gcfmm/static_field.hpp"
 
-#include <algorithm>
 
 using namespace LAMMPS_NS;
 
@@ -39,7 +35,7 @@ gcfmm::Options static_options(const gcfmm::Options &opts)
 
 CoulFMMSleepers::CoulFMMSleepers(LAMMPS *lmp, const gcfmm::Options &opts, int groupbit_in) :
     Pointers(lmp), field(new gcfmm::StaticSourceField(static_options(opts))), groupbit(groupbit_in),
-    flags(nullptr), generation(-1), built_generation(-2), built_box{0, 0, 0, 0, 0, 0}
+    flags(nullptr), generation(-1), built_generation(-2)
 {
 }
 
@@ -63,19 +59,15 @@ void CoulFMMSleepers::gather()
       sources);
 }
 
-void CoulFMMSleepers::prepare(const CoulFMMBackend &backend)
+void CoulFMMSleepers::prepare(const CoulFMMCell &cell)
 {
-  const double box[6] = {domain->boxlo[0], domain->boxlo[1], domain->xprd,
-                         domain->yprd,     domain->boxlo[2], domain->boxhi[2]};
-  bool same_box = true;
-  for (int k = 0; k < 6; k++) same_box = same_box && box[k] == built_box[k];
-  if (generation == built_generation && same_box) return;
+  if (generation == built_generation && cell == built_cell) return;
   gather();
-  backend.set_cell_of(*field);
+  cell.apply_to(*field);
   field->set_sources(sources.size(), sources.x.data(), sources.y.data(), sources.z.data(),
                      sources.q.data());
   built_generation = generation;
-  std::copy(box, box + 6, built_box);
+  built_cell = cell;
 }
 
 double CoulFMMSleepers::add_field(const double *x, const double *y, const double *z,

@@ -10,6 +10,7 @@
 #ifndef LMP_COUL_FMM_SLEEPERS_H
 #define LMP_COUL_FMM_SLEEPERS_H
 
+#include "coul_fmm_cell.h"
 #include "coul_fmm_comm.h"
 #include "pointers.h"
 
@@ -26,9 +27,10 @@ namespace LAMMPS_NS {
 
 // fix coul/fmm with fix sleep/gran: the sleeping charges as a static source
 // (doc/fix_coul_fmm.rst, "Sleeping particles"). Their field at the awake atoms comes from a
-// gcfmm::StaticSourceField built once per change of the sleeping set; the awake charges go
-// through the fix's Solver as before. Gathers the sleepers of all ranks sorted by atom ID (the
-// same set and order on every rank), and splits the awake targets among the ranks.
+// gcfmm::StaticSourceField built once per change of the sleeping set or of the cell; the awake
+// charges go through the fix's solver (CoulFMMEvaluator adds the two). Gathers the sleepers of
+// all ranks sorted by atom ID (the same set and order on every rank); the caller gives each rank
+// its share of the awake targets.
 class CoulFMMSleepers : protected Pointers {
  public:
   CoulFMMSleepers(class LAMMPS *, const gcfmm::Options &, int groupbit);
@@ -37,11 +39,10 @@ class CoulFMMSleepers : protected Pointers {
   // the sleeper flags (local atoms) of fix sleep/gran and the generation of its set
   void use(const double *asleep, bigint generation);
   bool asleep(int i) const { return flags && flags[i] != 0.0; }
-  const double *sleeping() const { return flags; }
 
-  // rebuild the static source if the sleeping set, the cell or the z range changed; throws
-  // what gcfmm throws
-  void prepare(const class CoulFMMBackend &backend);
+  // rebuild the static source if the sleeping set or the cell (the box, its z range) changed;
+  // throws what gcfmm throws
+  void prepare(const CoulFMMCell &cell);
   // ADD the sleepers' potential and field (bare 1/r kernel) at the targets [first, last) of
   // the gathered awake atoms; returns sum_t q_t pot_t over those targets
   double add_field(const double *x, const double *y, const double *z, const double *q,
@@ -59,7 +60,7 @@ class CoulFMMSleepers : protected Pointers {
   int groupbit;
   const double *flags;
   bigint generation, built_generation;
-  double built_box[6];
+  CoulFMMCell built_cell;
   GatheredCharges sources;
   void gather();
 };

@@ -295,10 +295,10 @@ void FixCoulFMM::post_force_respa(int vflag, int ilevel, int /*iloop*/)
   if (ilevel == ilevel_respa) post_force(vflag);
 }
 
+// every scheme evaluates a minimizer's positions afresh (CoulFMMScheme::compute)
 void FixCoulFMM::min_setup(int vflag)
 {
-  if (!dynamic_cast<CoulFMMPolarizable *>(scheme.get()) && stepping->settings().every > 1 &&
-      comm->me == 0)
+  if (stepping->settings().every > 1 && comm->me == 0)
     error->warning(FLERR,
                    "Fix coul/fmm {}: every {} is ignored during minimization (a minimizer "
                    "needs forces and energy of the current positions)",

@@ -23,6 +23,7 @@
 #include "pair.h"
 #include "update.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -34,7 +35,9 @@ namespace {
 // what pack_forward_comm() and pack_reverse_comm() move
 enum CommMode { COMM_FLAGS, COMM_PUSHED, COMM_PUSH, COMM_WAKE };
 // slots of the global restart list
-enum RestartSlot { R_SLEEP_EVENTS, R_WAKE_EVENTS, R_NSLOTS };
+enum RestartSlot { R_FALLEN_ASLEEP, R_WOKEN, R_NSLOTS };
+// the elements of the global vector (compute_vector's index)
+enum VectorElement { V_AWAKE, V_SLEEPING, V_FALLEN_ASLEEP, V_WOKEN, V_NELEMENTS };
 }    // namespace
 
 /* ---------------------------------------------------------------------- */
@@ -43,8 +46,8 @@ FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), speed_sleep(-1.0), force_sleep(-1.0), force_wake(-1.0), rest_time(-1.0),
     depth(0.0), every(100), rest_steps_needed(0), rest_rule(true), asleep(nullptr), pushed(nullptr),
     rest_steps(nullptr), push(nullptr), wake_mark(nullptr), ncontact(nullptr), comm_mode(COMM_FLAGS),
-    set_generation(0), nsleep_events(0), nwake_events(0), pair_bookkeeping(false),
-    pair_history(nullptr)
+    set_generation(0), fallen_asleep_total(0), woken_total(0), pair_history(nullptr),
+    active_build(-1), active_generation(-1)
 {
   if (!(atom->radius_flag && atom->rmass_flag && atom->omega_flag && atom->torque_flag))
     error->all(FLERR, "Fix {} requires atom attributes radius, rmass, omega and torque (atom_style sphere)", style);
@@ -94,7 +97,7 @@ FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
 
   scalar_flag = 1;
   vector_flag = 1;
-  size_vector = 4;
+  size_vector = V_NELEMENTS;
   global_freq = 1;
   extscalar = 0;
   extvector = 0;
@@ -145,8 +148,8 @@ void FixSleepGran::init()
   if (!force->pair_match("^granular", 0) || !force->pair->single_enable)
     error->all(FLERR, "Fix {} requires pair_style granular or granular/opt, not {}", style,
                force->pair_style ? force->pair_style : "none");
-  int dim = 0;
-  pair_bookkeeping = force->pair->extract("sleep/gran:bookkeeping", dim) != nullptr;
+  if (modify->get_fix_by_style("^sleep/gran$").size() > 1)
+    error->all(FLERR, "Only one fix sleep/gran may be defined");
   // the pair style's contact flags, if its models keep a history (fix neigh/history)
   auto histories = modify->get_fix_by_style("^NEIGH_HISTORY$");
   if (histories.size() > 1)
@@ -163,6 +166,7 @@ void FixSleepGran::init()
   }
   if (update->whichflag == 2) error->all(FLERR, "Fix {} cannot be used with minimization", style);
   check_fix_order();
+  active_build = active_generation = -1;    // the pair's list may be another one
   rest_steps_needed = static_cast<int>(std::ceil(rest_time / update->dt - 1e-9));
 }
 
@@ -232,7 +236,7 @@ void FixSleepGran::exchange_flags()
 
 void FixSleepGran::post_force(int /*vflag*/)
 {
-  if (!pair_bookkeeping) sum_contacts_and_push();
+  sum_contacts_and_push();
   if (force->newton_pair) {
     comm_mode = COMM_PUSH;
     comm->reverse_comm(this, 4);
@@ -252,9 +256,9 @@ void FixSleepGran::post_force(int /*vflag*/)
   }
 
   // falling asleep happens only on commit steps (fall_asleep() sums its count over the ranks)
-  const bigint before = nsleep_events;
+  const bigint before = fallen_asleep_total;
   if (update->ntimestep % every == 0) fall_asleep();
-  if (nsleep_events != before) {
+  if (fallen_asleep_total != before) {
     exchange_flags();
     set_generation++;
   }
@@ -262,9 +266,13 @@ void FixSleepGran::post_force(int /*vflag*/)
 }
 
 /* ----------------------------------------------------------------------
-   with a pair style that does not do the sleepers' bookkeeping: the contacts of this step
-   (touching pairs but those of two sleepers) and, for each sleeper, the contact forces of its
-   awake partners, recomputed by the pair's single() from the pair's neighbor list
+   the contacts of this step (touching pairs but those of two sleepers) and, for each sleeper,
+   the contact forces of its awake partners, recomputed by the pair's single() from the pair's
+   neighbor list after the pair has advanced the contact histories by the step: one bookkeeping
+   for every pair style, so that the wake decisions do not depend on the style. single() of a
+   sliding model rewrites the history of a slipping contact (LAMMPS's mindlin does, and the
+   Marshall set with it), at the level of rounding: the contact's history is restored after it,
+   so that the trajectory is the one without this fix
 ------------------------------------------------------------------------- */
 
 void FixSleepGran::sum_contacts_and_push()
@@ -277,7 +285,10 @@ void FixSleepGran::sum_contacts_and_push()
   const int nlocal = atom->nlocal;
   const int newton_pair = force->newton_pair;
   double *special_lj = force->special_lj;
-  for (int ii = 0; ii < list->inum; ii++) {
+  const int size_history = pair_history ? pair_history->get_dnum() : 0;
+  kept_history.resize(size_history);
+  update_active_entries(list);
+  for (const int ii : active_entries) {
     const int i = list->ilist[ii];
     const int *jlist = list->firstneigh[i];
     const int *touch = pair_history ? pair_history->firstflag[i] : nullptr;
@@ -293,7 +304,10 @@ void FixSleepGran::sum_contacts_and_push()
       double dx[3] = {x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]};
       const double rsq = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
       double fpair = 0.0;
+      double *history = pair_history ? &pair_history->firstvalue[i][size_history * jj] : nullptr;
+      if (history) std::copy(history, history + size_history, kept_history.begin());
       pair->single(i, j, type[i], type[j], rsq, 1.0, factor_lj, fpair);
+      if (history) std::copy(kept_history.begin(), kept_history.end(), history);
       // the force on i: normal (fpair along dx) plus the sliding force svector[0..2]
       for (int k = 0; k < 3; k++) {
         const double fk = factor_lj * (fpair * dx[k] + pair->svector[k]);
@@ -301,6 +315,27 @@ void FixSleepGran::sum_contacts_and_push()
         if (asleep[j] != 0.0 && j_here) push[j][k] -= fk;
       }
     }
+  }
+}
+
+/* ----------------------------------------------------------------------
+   the entries of the pair's list that hold a pair with an awake atom (an awake atom, or a
+   sleeper with an awake neighbor), rebuilt after each neighbor list build and each change of
+   the sleeping set
+------------------------------------------------------------------------- */
+
+void FixSleepGran::update_active_entries(const NeighList *list)
+{
+  if (active_build == neighbor->lastcall && active_generation == set_generation) return;
+  active_build = neighbor->lastcall;
+  active_generation = set_generation;
+  active_entries.clear();
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    bool keep = asleep[i] == 0.0;
+    const int *jlist = list->firstneigh[i];
+    for (int jj = 0; !keep && jj < list->numneigh[i]; jj++) keep = asleep[jlist[jj] & NEIGHMASK] == 0.0;
+    if (keep) active_entries.push_back(ii);
   }
 }
 
@@ -372,7 +407,7 @@ void FixSleepGran::wake_pushed()
   }
   bigint nw = nwoken, all = 0;
   MPI_Allreduce(&nw, &all, 1, MPI_LMP_BIGINT, MPI_SUM, world);
-  nwake_events += all;
+  woken_total += all;
   exchange_flags();
   set_generation++;
 }
@@ -433,7 +468,7 @@ void FixSleepGran::fall_asleep()
   }
   bigint all = 0;
   MPI_Allreduce(&n, &all, 1, MPI_LMP_BIGINT, MPI_SUM, world);
-  nsleep_events += all;
+  fallen_asleep_total += all;
 }
 
 /* ----------------------------------------------------------------------
@@ -510,13 +545,18 @@ bigint FixSleepGran::sleeping_count() const
   return all;
 }
 
+bigint FixSleepGran::awake_count() const
+{
+  return atom->natoms - sleeping_count();
+}
+
 /* ----------------------------------------------------------------------
-   the scalar is the awake count (the atoms still integrated), the same as vector element 1
+   the scalar: the awake count (the atoms still integrated), as vector element 1
 ------------------------------------------------------------------------- */
 
 double FixSleepGran::compute_scalar()
 {
-  return static_cast<double>(atom->natoms - sleeping_count());
+  return static_cast<double>(awake_count());
 }
 
 /* ----------------------------------------------------------------------
@@ -526,10 +566,16 @@ double FixSleepGran::compute_scalar()
 
 double FixSleepGran::compute_vector(int n)
 {
-  if (n == 0) return static_cast<double>(atom->natoms - sleeping_count());
-  if (n == 1) return static_cast<double>(sleeping_count());
-  if (n == 2) return static_cast<double>(nsleep_events);
-  return static_cast<double>(nwake_events);
+  switch (n) {
+    case V_AWAKE:
+      return static_cast<double>(awake_count());
+    case V_SLEEPING:
+      return static_cast<double>(sleeping_count());
+    case V_FALLEN_ASLEEP:
+      return static_cast<double>(fallen_asleep_total);
+    default:
+      return static_cast<double>(woken_total);
+  }
 }
 
 /* ---------------------------------------------------------------------- */
@@ -654,8 +700,8 @@ void FixSleepGran::write_restart(FILE *fp)
 {
   if (comm->me != 0) return;
   double list[R_NSLOTS];
-  list[R_SLEEP_EVENTS] = static_cast<double>(nsleep_events);
-  list[R_WAKE_EVENTS] = static_cast<double>(nwake_events);
+  list[R_FALLEN_ASLEEP] = static_cast<double>(fallen_asleep_total);
+  list[R_WOKEN] = static_cast<double>(woken_total);
   int size = R_NSLOTS * sizeof(double);
   fwrite(&size, sizeof(int), 1, fp);
   fwrite(list, sizeof(double), R_NSLOTS, fp);
@@ -664,8 +710,8 @@ void FixSleepGran::write_restart(FILE *fp)
 void FixSleepGran::restart(char *buf)
 {
   auto *list = reinterpret_cast<double *>(buf);
-  nsleep_events = static_cast<bigint>(list[R_SLEEP_EVENTS]);
-  nwake_events = static_cast<bigint>(list[R_WAKE_EVENTS]);
+  fallen_asleep_total = static_cast<bigint>(list[R_FALLEN_ASLEEP]);
+  woken_total = static_cast<bigint>(list[R_WOKEN]);
 }
 
 int FixSleepGran::pack_restart(int i, double *buf)

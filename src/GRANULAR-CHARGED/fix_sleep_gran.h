@@ -25,16 +25,15 @@ namespace LAMMPS_NS {
 // Sleeping particles for granular beds (doc/fix_sleep_gran.rst): a particle of the group that has
 // been at rest (speed, surface spin speed and net force below thresholds) for a stated time, and
 // optionally lies deep enough below the local bed surface, sleeps: velocity, spin, force and
-// torque are held at zero, so the integrator leaves it in place. A sleeper wakes, with the
-// sleepers touching it, when the contact force from its awake partners exceeds the wake
-// threshold. Falling asleep is committed every `every` steps, waking on the step.
+// torque are held at zero after the forces, so the integrator leaves it in place. The pair style
+// computes every contact as it does without this fix. A sleeper wakes, with the sleepers
+// touching it, when the contact force from its awake partners exceeds the wake threshold. Falling
+// asleep is committed every `every` steps, waking on the step.
 //
-// The state is published through extract() (names below), so that no pair style includes this
-// header and this fix includes no pair style's: a pair style that does the sleepers' bookkeeping
-// itself (pair_style granular/opt: sleeper pairs skipped, a sleeper a fixed body, the push and
-// contact counts summed in its loop) says so by its own extract("sleep/gran:bookkeeping"); with
-// any other granular pair style (pair_style granular) the fix counts the contacts and sums the
-// push itself from the pair's neighbor list, contact flags and single().
+// This fix keeps its own books for every granular pair style: it counts the contacts from the
+// pair's neighbor list and contact flags and sums the push of each awake-sleeper contact with
+// the pair's single(). The state is published through extract() (names below), so that other
+// styles (fix coul/fmm) read it without including this header.
 class FixSleepGran : public Fix {
  public:
   FixSleepGran(class LAMMPS *, int, char **);
@@ -70,9 +69,10 @@ class FixSleepGran : public Fix {
   // "generation" (dim 0, bigint): changes whenever the sleeping set may have changed on any rank
   //   (the same on all ranks)
   // "push" (dim 2): per atom (local and ghost), the contact force on a sleeper from its awake
-  //   partners (zeroed in pre_force, summed by the pair style or by this fix)
+  //   partners (zeroed in pre_force, summed in post_force)
   // "contacts" (dim 1): per atom (local and ghost), contacts computed this step (zeroed in
-  //   pre_force); only an atom that touches another can fall asleep
+  //   pre_force, counted in post_force; pairs of two sleepers not counted); only an atom that
+  //   touches another can fall asleep
   void *extract(const char *, int &) override;
 
  private:
@@ -89,15 +89,21 @@ class FixSleepGran : public Fix {
   int comm_mode;         // what pack_forward_comm / pack_reverse_comm move
 
   bigint set_generation;
-  bigint nsleep_events, nwake_events;
-  bool pair_bookkeeping;    // the pair style sums push and contacts itself
+  // atoms that fell asleep and atoms woken since the fix was defined (kept across restarts)
+  bigint fallen_asleep_total, woken_total;
   class FixNeighHistory *pair_history;    // the pair style's contact flags (null: none)
+  std::vector<double> kept_history;       // one contact's history, kept across single()
+  // the entries of the pair's list with an awake atom or neighbor (update_active_entries())
+  std::vector<int> active_entries;
+  bigint active_build, active_generation;    // the list build and sleeping set they are of
 
   void exchange_flags();
   void sum_contacts_and_push();
+  void update_active_entries(const class NeighList *list);
   void mark_touching_sleepers();
   bool touching(int i, int j, int jj, const int *touch) const;
   bigint sleeping_count() const;
+  bigint awake_count() const;
   bool at_rest(int i) const;
   void fall_asleep();
   void wake_pushed();

@@ -71,6 +71,9 @@ void FixWallGranOpt::init()
   if (fused && (coeffs.hist_tangential < 1 || coeffs.hist_tangential + 3 > size_history))
     fused = false;
   scales_radius = -1.0;
+  // at a wall both rolling conventions limit xi at theta_crit R_eff = theta_crit r_p
+  wall_coeffs = coeffs;
+  wall_coeffs.roll_radius_factor = 1.0;
 
   if (comm->me == 0 && !reported) {
     utils::logmesg(lmp, "fix {} (wall/gran/opt): {}\n", id,
@@ -212,42 +215,19 @@ void FixWallGranOpt::gather_contacts()
 void FixWallGranOpt::pack_contact(const WallContact &c, double root, double *in, int stride)
 {
   namespace ML = MarshallLanes;
-  auto put = [in, stride](int q, double value) { in[q * stride] = value; };
+  static constexpr double at_rest[3] = {0.0, 0.0, 0.0};
   const int i = c.i;
   const double radi = atom->radius[i];
   const double *history = history_one[i];
-  const MK::JKRScales &sc = scales_of(radi);
-  for (int k = 0; k < 3; k++) {
-    put(ML::DX + k, k == wallstyle ? c.dist : 0.0);
-    put(ML::VR + k, atom->v[i][k]);
-    put(ML::OMEGA_I + k, atom->omega[i][k]);
-    put(ML::OMEGA_J + k, 0.0);
-    put(ML::HIST_T + k, history[coeffs.hist_tangential + k]);
-    put(ML::HIST_R + k, coeffs.rolling ? history[coeffs.hist_rolling + k] : 0.0);
-  }
-  put(ML::HIST_TW, coeffs.twisting ? history[coeffs.hist_twisting] : 0.0);
-  put(ML::RAD_I, radi);
-  put(ML::RAD_J, 0.0);
-  put(ML::REFF, radi);
-  put(ML::ROOT, root);
-  put(ML::ASEP, sc.asep);
-  put(ML::FC, sc.fc);
-  put(ML::SQRT_KN_SEP, sc.sqrt_kn_sep);
-  put(ML::MASS_FACTOR, coeffs.mass_factor);
-  put(ML::MASS_I, atom->rmass[i]);
-  put(ML::MASS_J, 0.0);    // unused: the wall is the fixed body
-  put(ML::FIXED, ML::FIXED_J);
-  put(ML::ALPHA, coeffs.alpha);
-  put(ML::K_T, coeffs.k_t);
-  put(ML::MU, coeffs.mu);
-  put(ML::DT, model->dt);
-  // at a wall both rolling conventions limit xi at theta_crit R_eff = theta_crit r_p
-  put(ML::XI_CRIT, coeffs.rolling ? coeffs.theta_crit * radi : 0.0);
-  put(ML::ROLLING, coeffs.rolling ? 1.0 : 0.0);
-  put(ML::TWISTING, coeffs.twisting ? 1.0 : 0.0);
-  put(ML::HERTZ, coeffs.gamma == 0.0 ? 1.0 : 0.0);
-  put(ML::EMIX, coeffs.emix);
-  put(ML::LEVER_SHIFT, ML::LEVER_SHIFT_WALL);
+  double dx[3] = {0.0, 0.0, 0.0};
+  dx[wallstyle] = c.dist;
+  ML::pack_contact_state(in, stride, dx, atom->v[i], at_rest, atom->omega[i], at_rest,
+                         history + coeffs.hist_tangential,
+                         coeffs.rolling ? history + coeffs.hist_rolling : nullptr,
+                         coeffs.twisting ? history + coeffs.hist_twisting : nullptr, root,
+                         atom->rmass[i], 0.0, ML::FIXED_J);
+  ML::pack_contact_model(in, stride, wall_coeffs, model->dt, radi, 0.0, radi, scales_of(radi),
+                         ML::LEVER_SHIFT_WALL);
 }
 
 /* ----------------------------------------------------------------------
@@ -260,12 +240,14 @@ void FixWallGranOpt::unpack_contact(const WallContact &c, const double *out, int
   namespace ML = MarshallLanes;
   const int i = c.i;
   double *history = history_one[i];
+  ML::unpack_histories(out, stride, history + coeffs.hist_tangential,
+                       coeffs.rolling ? history + coeffs.hist_rolling : nullptr,
+                       coeffs.twisting ? history + coeffs.hist_twisting : nullptr);
+  double force[3], torque_i[3], torque_j[3];
+  ML::unpack_forces(out, stride, 1.0, force, torque_i, torque_j);
   double *f = atom->f[i], *torque = atom->torque[i];
   for (int k = 0; k < 3; k++) {
-    history[coeffs.hist_tangential + k] = out[(ML::OUT_HIST_T + k) * stride];
-    if (coeffs.rolling) history[coeffs.hist_rolling + k] = out[(ML::OUT_HIST_R + k) * stride];
-    f[k] = f[k] + out[(ML::FORCE + k) * stride];
-    torque[k] = torque[k] + out[(ML::TORQUE_I + k) * stride];
+    f[k] = f[k] + force[k];
+    torque[k] = torque[k] + torque_i[k];
   }
-  if (coeffs.twisting) history[coeffs.hist_twisting] = out[ML::OUT_HIST_TW * stride];
 }

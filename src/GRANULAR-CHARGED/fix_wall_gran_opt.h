@@ -44,6 +44,7 @@ class FixWallGranOpt : public FixWallGran {
   bool fused;                          // the fused loop applies to this wall
   bool reported;                       // the log line of init() was written
   MarshallFusedSet::Coeffs coeffs;     // the wall model's coefficients
+  MarshallFusedSet::Coeffs wall_coeffs;    // the same with the rolling limit of a wall contact
   // JKR scales of the last particle radius seen (a flat wall's R_eff is the particle radius)
   double scales_radius;
   MarshallKernels::JKRScales scales;

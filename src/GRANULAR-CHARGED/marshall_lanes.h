@@ -89,7 +89,7 @@ namespace MarshallLanes {
     MASS_FACTOR,         // damping marshall 2, marshall/printed 1
     MASS_I,              // mass of i
     MASS_J,              // mass of j
-    FIXED,               // FIXED_NONE, FIXED_I or FIXED_J: which one is a fixed body
+    FIXED,               // FIXED_NONE, FIXED_I or FIXED_J: which one is frozen
     ALPHA,               // damping alpha(e)
     K_T,                 // 8 G*
     MU,                  // sliding friction coefficient
@@ -120,7 +120,8 @@ namespace MarshallLanes {
     N_OUTPUT
   };
 
-  // a frozen atom (fix freeze) or a sleeper is a fixed body: m* is the other's mass
+  // an atom of fix freeze is a fixed body: m* is the other's mass (PairGranular's rule for
+  // freeze_group_bit, j's before i's)
   constexpr double FIXED_NONE = 0.0, FIXED_I = 1.0, FIXED_J = 2.0;
   template <class T> GC_KERNEL_INLINE T effective_mass(T mass_i, T mass_j, T fixed)
   {
@@ -223,6 +224,91 @@ namespace MarshallLanes {
       out[OUT_HIST_R + k] = N::select(rolling, hist_r[k], in(HIST_R + k));
     }
     out[OUT_HIST_TW] = N::select(twisting, phi, in(HIST_TW));
+  }
+
+  /* ---------------------------------------------------------------------
+     pack and unpack of one contact: its inputs written into, and its results read from, a
+     lanes block (stride WIDTH, from the contact's lane) or one contact's arrays (stride 1).
+     Each value is its own store: a record built whole and copied stalls the store-to-load
+     forwarding of its parts when the kernel reads them back.
+  --------------------------------------------------------------------- */
+
+  // the inputs of a contact's atoms and history: x_i - x_j, velocities, spins, the histories of
+  // its sub-models (null: none, packed as 0), the JKR root s (any value without adhesion),
+  // masses and which atom is frozen
+  GC_KERNEL_INLINE void pack_contact_state(double *in, int stride, const double *dx,
+                                           const double *v_i, const double *v_j,
+                                           const double *omega_i, const double *omega_j,
+                                           const double *history_t, const double *history_r,
+                                           const double *history_tw, double root, double mass_i,
+                                           double mass_j, double fixed)
+  {
+    auto put = [in, stride](int q, double value) GC_KERNEL_LAMBDA { in[q * stride] = value; };
+    for (int k = 0; k < 3; k++) {
+      put(DX + k, dx[k]);
+      put(VR + k, v_i[k] - v_j[k]);
+      put(OMEGA_I + k, omega_i[k]);
+      put(OMEGA_J + k, omega_j[k]);
+      put(HIST_T + k, history_t[k]);
+      put(HIST_R + k, history_r ? history_r[k] : 0.0);
+    }
+    put(HIST_TW, history_tw ? history_tw[0] : 0.0);
+    put(ROOT, root);
+    put(MASS_I, mass_i);
+    put(MASS_J, mass_j);
+    put(FIXED, fixed);
+  }
+
+  // the inputs of a contact's model and radii, the same for every contact of one model between
+  // atoms of the same two radii. Coeffs: MarshallFusedSet::Coeffs (emix, gamma, alpha,
+  // mass_factor, k_t, mu, rolling, theta_crit, roll_radius_factor, twisting); lever_shift:
+  // LEVER_SHIFT_PAIR or LEVER_SHIFT_WALL
+  template <class Coeffs>
+  GC_KERNEL_INLINE void pack_contact_model(double *in, int stride, const Coeffs &model, double dt,
+                                           double rad_i, double rad_j, double reff,
+                                           const MarshallKernels::JKRScales &scales,
+                                           double lever_shift)
+  {
+    auto put = [in, stride](int q, double value) GC_KERNEL_LAMBDA { in[q * stride] = value; };
+    put(RAD_I, rad_i);
+    put(RAD_J, rad_j);
+    put(REFF, reff);
+    put(ASEP, scales.asep);
+    put(FC, scales.fc);
+    put(SQRT_KN_SEP, scales.sqrt_kn_sep);
+    put(MASS_FACTOR, model.mass_factor);
+    put(ALPHA, model.alpha);
+    put(K_T, model.k_t);
+    put(MU, model.mu);
+    put(DT, dt);
+    put(XI_CRIT, model.rolling ? model.theta_crit * (model.roll_radius_factor * reff) : 0.0);
+    put(ROLLING, model.rolling ? 1.0 : 0.0);
+    put(TWISTING, model.twisting ? 1.0 : 0.0);
+    put(HERTZ, model.gamma == 0.0 ? 1.0 : 0.0);
+    put(EMIX, model.emix);
+    put(LEVER_SHIFT, lever_shift);
+  }
+
+  // the histories of a contact's sub-models back (null: the model has none)
+  GC_KERNEL_INLINE void unpack_histories(const double *out, int stride, double *history_t,
+                                         double *history_r, double *history_tw)
+  {
+    for (int k = 0; k < 3; k++) {
+      history_t[k] = out[(OUT_HIST_T + k) * stride];
+      if (history_r) history_r[k] = out[(OUT_HIST_R + k) * stride];
+    }
+    if (history_tw) history_tw[0] = out[OUT_HIST_TW * stride];
+  }
+
+  // the force on i and the torques on i and j, times factor (the special-bond factor)
+  GC_KERNEL_INLINE void unpack_forces(const double *out, int stride, double factor,
+                                      double *force, double *torque_i, double *torque_j)
+  {
+    for (int k = 0; k < 3; k++) {
+      force[k] = factor * out[(FORCE + k) * stride];
+      torque_i[k] = factor * out[(TORQUE_I + k) * stride];
+      torque_j[k] = factor * out[(TORQUE_J + k) * stride];
+    }
   }
 
   // nblocks blocks of WIDTH contacts: block b's input q of lane l at

@@ -39,9 +39,9 @@ namespace ML = MarshallLanes;
 /* ---------------------------------------------------------------------- */
 
 PairGranularOpt::PairGranularOpt(LAMMPS *lmp) :
-    PairGranular(lmp), fused_ready(false), generic_only(true), all_fused(false), any_heat(false),
-    sleep_fix(nullptr), active_build(-1), active_generation(-1), ncontacts(0), history_update(true),
-    hist_tangential(0), hist_rolling(0), hist_twisting(0), history_handover(lmp)
+    PairGranular(lmp), fused_ready(false), generic_only(true), any_heat(false), ncontacts(0),
+    history_update(true), hist_tangential(0), hist_rolling(0), hist_twisting(0),
+    history_handover(lmp)
 {
 }
 
@@ -72,38 +72,7 @@ void PairGranularOpt::init_style()
   PairGranular::init_style();
   if (first_init) history_handover.history_created(fix_history);
   fused_ready = false;    // init_one() may still mix new models: set up before the first compute
-  auto sleepers = modify->get_fix_by_style("^sleep/gran$");
-  sleep_fix = sleepers.empty() ? nullptr : sleepers.front();
-  if (sleepers.size() > 1) error->all(FLERR, "Only one fix sleep/gran may be defined");
-  active_build = active_generation = -1;
   FixChargeCheck::ensure(lmp);    // charges without a Coulomb solver: warned at init
-}
-
-/* ---------------------------------------------------------------------- */
-
-void *PairGranularOpt::extract(const char *name, int &dim)
-{
-  if (strcmp(name, "sleep/gran:bookkeeping") == 0) {
-    // asked by fix sleep/gran's init(), after init_one() has mixed every model
-    if (!fused_ready) setup_fused();
-    dim = 0;
-    return all_fused && !fix_rigid ? this : nullptr;
-  }
-  return PairGranular::extract(name, dim);
-}
-
-/* ---------------------------------------------------------------------- */
-
-PairGranularOpt::SleepArrays PairGranularOpt::sleep_arrays() const
-{
-  SleepArrays s;
-  if (!sleep_fix) return s;
-  int dim = 0;
-  s.asleep = static_cast<const double *>(sleep_fix->extract("sleeping", dim));
-  s.push = static_cast<double **>(sleep_fix->extract("push", dim));
-  s.ncontact = static_cast<double *>(sleep_fix->extract("contacts", dim));
-  s.generation = *static_cast<bigint *>(sleep_fix->extract("generation", dim));
-  return s;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -125,13 +94,11 @@ void PairGranularOpt::setup_fused()
 {
   fused.assign(nmodels, FusedMarshall());
   bool any_fused = false;
-  all_fused = true;
   any_heat = false;
   for (int n = 0; n < nmodels; n++) {
     FusedMarshall &f = fused[n];
     f.on = MarshallFusedSet::of_model(models_list[n], f);
     any_fused = any_fused || f.on;
-    all_fused = all_fused && f.on;
     // a heat model needs PairGranular's heat-flow bookkeeping, which the fused loop does not do
     any_heat = any_heat || models_list[n]->sub_models[HEAT]->name != "none";
     if (!f.on) continue;
@@ -146,20 +113,20 @@ void PairGranularOpt::setup_fused()
 /* ----------------------------------------------------------------------
    PairGranular::compute() with the Marshall set fused, as a recipe: set-up, gather (the
    contacts' life decided, the pairs outside the fused set handed to PairGranular::compute on a
-   list of their own), the JKR roots in one batch, the fused kernel in SIMD lanes
-   (marshall_lanes.h), then the scatter and the sleepers' bookkeeping per contact. The fused kernel does what GranularModel::check_contact()
-   and calculate_forces() do with the Marshall sub-models, in the same order of operations,
-   skipping what the set does not use (relative tangential speed, heat, classic torque scaling).
-   The history of a pair is the same array at the same offsets, so fix neigh/history, restarts
-   and single() see no difference.
+   list of their own), the JKR roots in one batch, each contact packed into SIMD lanes, the
+   fused kernel, each contact's results unpacked (marshall_lanes.h). The fused kernel does what
+   GranularModel::check_contact() and calculate_forces() do with the Marshall sub-models, in the
+   same order of operations, skipping what the set does not use (relative tangential speed,
+   heat, classic torque scaling). The history of a pair is the same array at the same offsets,
+   so fix neigh/history, restarts and single() see no difference. Every pair of the list is
+   computed, as by PairGranular, whatever fixes hold its atoms (fix freeze, fix sleep/gran).
 ------------------------------------------------------------------------- */
 
 void PairGranularOpt::compute(int eflag, int vflag)
 {
   if (!fused_ready) setup_fused();
-  // nothing to fuse, a heat model, rigid-body masses, or sleepers with a model outside the
-  // fused set (fix sleep/gran then does the bookkeeping itself): the sub-model path does it all
-  if (generic_only || fix_rigid || (sleep_fix && !all_fused)) {
+  // nothing to fuse, a heat model or rigid-body masses: the sub-model path does it all
+  if (generic_only || fix_rigid) {
     PairGranular::compute(eflag, vflag);
     return;
   }
@@ -174,8 +141,7 @@ void PairGranularOpt::compute(int eflag, int vflag)
 }
 
 /* ----------------------------------------------------------------------
-   set-up of one compute(): history updates, tallies, the sleepers' arrays and active list,
-   the JKR scales of each type pair when every atom of a type has the same radius
+   set-up of one compute(): history updates, tallies, the JKR scales of each type pair when every atom of a type has the same radius
 ------------------------------------------------------------------------- */
 
 void PairGranularOpt::begin_step(int eflag, int vflag)
@@ -183,8 +149,6 @@ void PairGranularOpt::begin_step(int eflag, int vflag)
   history_update = update->setupflag == 0;
   for (int n = 0; n < nmodels; n++) models_list[n]->history_update = history_update;
   ev_init(eflag, vflag);
-  sleep = sleep_arrays();
-  if (sleep.asleep) update_active(sleep.asleep, sleep.generation);
   type_scales();
 }
 
@@ -251,15 +215,12 @@ void PairGranularOpt::gather_contacts()
   double *radius = atom->radius;
   double *special_lj = force->special_lj;
   const int size_hist = get_size_history();
-  const double *asleep = sleep.asleep;
   const int inum = list->inum;
-  const int nactive = asleep ? static_cast<int>(active.size()) : inum;
   contacts.clear();
   jkr_overlap.clear();
   generic_i.clear();
   generic_jj.clear();
-  for (int aa = 0; aa < nactive; aa++) {
-    const int ii = asleep ? active[aa] : aa;
+  for (int ii = 0; ii < inum; ii++) {
     const int i = list->ilist[ii];
     int *touch = use_history ? fix_history->firstflag[i] : nullptr;
     double *allhistory = use_history ? fix_history->firstvalue[i] : nullptr;
@@ -269,14 +230,12 @@ void PairGranularOpt::gather_contacts()
     // contacts would otherwise make the compiler read them again for each)
     const double xi[3] = {x[i][0], x[i][1], x[i][2]};
     const double radi = radius[i];
-    const bool i_asleep = asleep && asleep[i] != 0.0;
     const int *models_of_i = types_indices[type[i]];
     const FusedMarshall *fused_models = fused.data();
     for (int jj = 0; jj < jnum; jj++) {
       const int j = jlist[jj] & NEIGHMASK;
       const double factor_lj = special_lj[sbmask(jlist[jj])];
       if (factor_lj == 0) continue;
-      if (i_asleep && asleep[j] != 0.0) continue;
       const int model = models_of_i[type[j]];
       const FusedMarshall &fm = fused_models[model];
       if (!fm.on) {
@@ -393,10 +352,10 @@ void PairGranularOpt::build_generic_list()
 
 /* ----------------------------------------------------------------------
    the fused contacts in list order, a chunk at a time (its lanes blocks stay in the L1
-   cache): the adhesive contacts gathered into lanes blocks and evaluated by the lanes kernel
+   cache): the adhesive contacts packed into lanes blocks and evaluated by the lanes kernel
    (marshall_lanes.h) on the default SIMD path, the others (no adhesion: Hertz's law) by the
-   scalar instantiation of the same kernel; then scatter and the sleepers' bookkeeping per
-   contact in list order, so the sums over contacts are those of a scalar loop
+   scalar instantiation of the same kernel; then each contact's results unpacked and summed in
+   list order, so the sums over contacts are those of a scalar loop
 ------------------------------------------------------------------------- */
 
 void PairGranularOpt::compute_fused_contacts()
@@ -417,63 +376,31 @@ void PairGranularOpt::compute_fused_contacts()
   const int *mask = atom->mask;
   const int nlocal = atom->nlocal;
   const int newton_pair = force->newton_pair;
-  const double *asleep = sleep.asleep;
   double **allhistory = fix_history->firstvalue;
   const int size_hist = get_size_history();
-  // the inputs of one contact (marshall_lanes.h), input q at in[q * stride], in two parts: those
-  // of the contact's atoms and history (s: its JKR root, unused without adhesion) and those of
-  // its model and type pair, the same for every contact of one type pair of one radius each
-  auto gather_own = [&](const Contact &c, double s, double *in, int stride) {
+  // a contact's inputs (marshall_lanes.h) in two parts: those of its atoms and history (s: its
+  // JKR root, unused without adhesion) and those of its model and type pair, the same for every
+  // contact of one type pair of one radius each
+  auto pack_state = [&](const Contact &c, double s, double *in, int stride) {
     const int i = c.i, j = c.j;
     const FusedMarshall &fm = fused[c.model];
     const double *history = &allhistory[i][size_hist * c.jj];
-    auto put = [in, stride](int q, double value) { in[q * stride] = value; };
-    for (int k = 0; k < 3; k++) {
-      put(ML::DX + k, c.dx[k]);
-      put(ML::VR + k, v[i][k] - v[j][k]);
-      put(ML::OMEGA_I + k, omega[i][k]);
-      put(ML::OMEGA_J + k, omega[j][k]);
-      put(ML::HIST_T + k, history[hist_tangential + k]);
-      put(ML::HIST_R + k, fm.rolling ? history[hist_rolling + k] : 0.0);
-    }
-    put(ML::HIST_TW, fm.twisting ? history[hist_twisting] : 0.0);
-    put(ML::ROOT, s);
-    put(ML::MASS_I, rmass[i]);
-    put(ML::MASS_J, rmass[j]);
-    // a frozen atom or a sleeper is a fixed body, in this order of precedence
     double fixed = ML::FIXED_NONE;
     if (mask[i] & freeze_group_bit) fixed = ML::FIXED_I;
     if (mask[j] & freeze_group_bit) fixed = ML::FIXED_J;
-    if (asleep && asleep[i] != 0.0) fixed = ML::FIXED_I;
-    if (asleep && asleep[j] != 0.0) fixed = ML::FIXED_J;
-    put(ML::FIXED, fixed);
+    ML::pack_contact_state(in, stride, c.dx, v[i], v[j], omega[i], omega[j],
+                           history + hist_tangential, fm.rolling ? history + hist_rolling : nullptr,
+                           fm.twisting ? history + hist_twisting : nullptr, s, rmass[i], rmass[j],
+                           fixed);
   };
-  auto gather_shared = [&](const Contact &c, double *in, int stride) {
-    const FusedMarshall &fm = fused[c.model];
+  auto pack_model = [&](const Contact &c, double *in, int stride) {
     const PairScales &ps = pair_scales[c.scales];
-    const double reff = ps.reff;
-    auto put = [in, stride](int q, double value) { in[q * stride] = value; };
-    put(ML::RAD_I, radius[c.i]);
-    put(ML::RAD_J, radius[c.j]);
-    put(ML::REFF, reff);
-    put(ML::ASEP, ps.scales.asep);
-    put(ML::FC, ps.scales.fc);
-    put(ML::SQRT_KN_SEP, ps.scales.sqrt_kn_sep);
-    put(ML::MASS_FACTOR, fm.mass_factor);
-    put(ML::ALPHA, fm.alpha);
-    put(ML::K_T, fm.k_t);
-    put(ML::MU, fm.mu);
-    put(ML::DT, model_dt[c.model]);
-    put(ML::XI_CRIT, fm.rolling ? fm.theta_crit * (fm.roll_radius_factor * reff) : 0.0);
-    put(ML::ROLLING, fm.rolling ? 1.0 : 0.0);
-    put(ML::TWISTING, fm.twisting ? 1.0 : 0.0);
-    put(ML::HERTZ, fm.gamma == 0.0 ? 1.0 : 0.0);
-    put(ML::EMIX, fm.emix);
-    put(ML::LEVER_SHIFT, ML::LEVER_SHIFT_PAIR);
+    ML::pack_contact_model(in, stride, fused[c.model], model_dt[c.model], radius[c.i],
+                           radius[c.j], ps.reff, ps.scales, ML::LEVER_SHIFT_PAIR);
   };
-  auto gather_contact = [&](const Contact &c, double s, double *in, int stride) {
-    gather_own(c, s, in, stride);
-    gather_shared(c, in, stride);
+  auto pack_contact = [&](const Contact &c, double s, double *in, int stride) {
+    pack_state(c, s, in, stride);
+    pack_model(c, in, stride);
   };
   // the force and torque on atom i summed in registers over its consecutive contacts (those of
   // one entry of the neighbor list, none of which has i as its neighbor j): f[i] and torque[i]
@@ -487,46 +414,35 @@ void PairGranularOpt::compute_fused_contacts()
     copy3(sums.f, f[sums.i]);
     copy3(sums.torque, torque[sums.i]);
   };
-  // the results of one contact back: its histories (the sub-models it has), forces and torques
-  // times factor_lj to the atoms, the tallies, the sleepers' contact count and push; input and
-  // output q at in[q * stride], out[q * stride]
-  auto scatter_contact = [&](const Contact &c, const double *out, int stride) {
+  // a contact's results: its histories (the sub-models it has), forces and torques times
+  // factor_lj to the atoms, the tallies
+  auto unpack_contact = [&](const Contact &c, const double *out, int stride) {
     const int i = c.i, j = c.j;
     const FusedMarshall &fm = fused[c.model];
     double *history = &allhistory[i][size_hist * c.jj];
-    for (int k = 0; k < 3; k++) {
-      history[hist_tangential + k] = out[(ML::OUT_HIST_T + k) * stride];
-      if (fm.rolling) history[hist_rolling + k] = out[(ML::OUT_HIST_R + k) * stride];
-    }
-    if (fm.twisting) history[hist_twisting] = out[ML::OUT_HIST_TW * stride];
-
+    ML::unpack_histories(out, stride, history + hist_tangential,
+                         fm.rolling ? history + hist_rolling : nullptr,
+                         fm.twisting ? history + hist_twisting : nullptr);
     if (i != sums.i) {
       store_sums();
       sums.i = i;
       copy3(f[i], sums.f);
       copy3(torque[i], sums.torque);
     }
-    const double factor_lj = c.factor_lj;
-    double forces[3];
+    double forces[3], torque_i[3], torque_j[3];
+    ML::unpack_forces(out, stride, c.factor_lj, forces, torque_i, torque_j);
     for (int k = 0; k < 3; k++) {
-      forces[k] = factor_lj * out[(ML::FORCE + k) * stride];
       sums.f[k] = sums.f[k] + forces[k];
-      sums.torque[k] = sums.torque[k] + factor_lj * out[(ML::TORQUE_I + k) * stride];
+      sums.torque[k] = sums.torque[k] + torque_i[k];
     }
-    const bool j_here = newton_pair || j < nlocal;
-    if (j_here)
+    if (newton_pair || j < nlocal)
       for (int k = 0; k < 3; k++) {
         f[j][k] = f[j][k] - forces[k];
-        torque[j][k] = torque[j][k] + factor_lj * out[(ML::TORQUE_J + k) * stride];
+        torque[j][k] = torque[j][k] + torque_j[k];
       }
     if (evflag)
       ev_tally_xyz(i, j, nlocal, newton_pair, 0.0, 0.0, forces[0], forces[1], forces[2], c.dx[0],
                    c.dx[1], c.dx[2]);
-    if (!asleep) return;
-    sleep.ncontact[i] += 1.0;
-    if (j_here) sleep.ncontact[j] += 1.0;
-    if (asleep[i] != 0.0) add3(sleep.push[i], forces, sleep.push[i]);
-    if (asleep[j] != 0.0 && j_here) sub3(sleep.push[j], forces, sleep.push[j]);
   };
 
   model_dt.resize(nmodels);
@@ -537,7 +453,7 @@ void PairGranularOpt::compute_fused_contacts()
   for (std::size_t k = 0; k < n && one_pair; k++)
     one_pair = contacts[k].model == contacts[0].model && contacts[k].scales == contacts[0].scales;
   if (one_pair)
-    for (int l = 0; l < static_cast<int>(CHUNK); l++) gather_shared(contacts[0], lane_input(l), W);
+    for (int l = 0; l < static_cast<int>(CHUNK); l++) pack_model(contacts[0], lane_input(l), W);
   std::size_t next_root = 0;
   for (std::size_t start = 0; start < n; start += CHUNK) {
     const std::size_t m = std::min(CHUNK, n - start);
@@ -545,7 +461,7 @@ void PairGranularOpt::compute_fused_contacts()
     for (std::size_t k = 0; k < m; k++) {
       const Contact &c = contacts[start + k];
       // the neighbor's data a few contacts ahead: each contact's loads then overlap with the
-      // gathering of the previous ones
+      // packing of the previous ones
       if (start + k + PREFETCH < n) {
         const int jn = contacts[start + k + PREFETCH].j;
         __builtin_prefetch(v[jn]);
@@ -557,9 +473,9 @@ void PairGranularOpt::compute_fused_contacts()
       }
       lane_of[k] = nlanes;
       if (one_pair)
-        gather_own(c, jkr_root[next_root++], lane_input(nlanes), W);
+        pack_state(c, jkr_root[next_root++], lane_input(nlanes), W);
       else
-        gather_contact(c, jkr_root[next_root++], lane_input(nlanes), W);
+        pack_contact(c, jkr_root[next_root++], lane_input(nlanes), W);
       nlanes++;
     }
     // a short last block: its other lanes evaluate copies of its first contact, not scattered
@@ -574,35 +490,14 @@ void PairGranularOpt::compute_fused_contacts()
         __builtin_prefetch(torque[jn], 1);
       }
       if (lane_of[k] >= 0) {
-        scatter_contact(c, lane_output(lane_of[k]), W);
+        unpack_contact(c, lane_output(lane_of[k]), W);
       } else {
         double in[ML::N_INPUT], out[ML::N_OUTPUT];
-        gather_contact(c, 1.0, in, 1);
+        pack_contact(c, 1.0, in, 1);
         ML::marshall_contact(in, out, history_update);
-        scatter_contact(c, out, 1);
+        unpack_contact(c, out, 1);
       }
     }
   }
   store_sums();
-}
-
-/* ----------------------------------------------------------------------
-   the list entries that can hold a computed pair: an awake atom, or a sleeper with an awake
-   neighbor
-------------------------------------------------------------------------- */
-
-void PairGranularOpt::update_active(const double *asleep, bigint generation)
-{
-  if (active_build == neighbor->lastcall && active_generation == generation) return;
-  active_build = neighbor->lastcall;
-  active_generation = generation;
-  active.clear();
-  const int inum = list->inum;
-  for (int ii = 0; ii < inum; ii++) {
-    const int i = list->ilist[ii];
-    bool keep = asleep[i] == 0.0;
-    const int *jlist = list->firstneigh[i];
-    for (int jj = 0; !keep && jj < list->numneigh[i]; jj++) keep = asleep[jlist[jj] & NEIGHMASK] == 0.0;
-    if (keep) active.push_back(ii);
-  }
 }

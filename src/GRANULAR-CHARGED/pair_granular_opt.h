@@ -28,7 +28,7 @@ namespace LAMMPS_NS {
 
 // pair_style granular with a fused kernel for the Marshall sub-model set (jkr/marshall,
 // damping marshall[/printed], tangential marshall, optional rolling marshall[/particle] and
-// twisting marshall/jkr): the touching pairs gathered into SIMD lanes and evaluated several at a
+// twisting marshall/jkr): the touching pairs packed into SIMD lanes and evaluated several at a
 // time by the inline equations of marshall_kernels.h (marshall_lanes.h), no virtual calls.
 // Every other type pair runs PairGranular::compute on a list of those pairs only. Same
 // pair_coeff syntax, history layout, restart and single() as granular
@@ -43,9 +43,6 @@ class PairGranularOpt : public PairGranular {
   // for tests and the log: does model n run the fused kernel?
   bool model_is_fused(int n) const;
 
-  // "sleep/gran:bookkeeping": this style skips the pairs of two sleepers of fix sleep/gran,
-  // treats a sleeper as a fixed body and sums the fix's push and contact counts in its loop
-  void *extract(const char *, int &) override;
   // contacts (touching pairs) whose forces the last compute() evaluated in its own loop
   bigint contacts_computed() const { return ncontacts; }
 
@@ -57,22 +54,7 @@ class PairGranularOpt : public PairGranular {
   std::vector<FusedMarshall> fused;      // one per entry of models_list
   bool fused_ready;                      // false after init_style(): rebuild before compute()
   bool generic_only;                     // no model fused (or a heat model): PairGranular's path
-  bool all_fused;                        // every model fused (then sleepers are handled here)
   bool any_heat;                         // a model with heat conduction
-  class Fix *sleep_fix;                  // fix sleep/gran, if defined (read through extract())
-  // the fix's arrays for this compute() (extract() names of fix_sleep_gran.h)
-  struct SleepArrays {
-    const double *asleep = nullptr;    // 1.0 sleeping, 0.0 awake
-    double **push = nullptr;           // contact force from awake partners on a sleeper
-    double *ncontact = nullptr;        // contacts computed this step
-    bigint generation = 0;             // changes with the sleeping set
-  };
-  SleepArrays sleep_arrays() const;
-  SleepArrays sleep;                     // of this compute()
-  // with sleepers: the list entries ii whose atom is awake or has an awake neighbor, rebuilt
-  // after each neighbor list build and each change of the sleeping set
-  std::vector<int> active;
-  bigint active_build, active_generation;
   bigint ncontacts;
   bool history_update;                   // this compute() advances the contact histories
   int hist_tangential, hist_rolling, hist_twisting;    // offsets in the per-pair history
@@ -113,7 +95,6 @@ class PairGranularOpt : public PairGranular {
   std::vector<double *> generic_firsthistory;
 
   void setup_fused();
-  void update_active(const double *asleep, bigint generation);
   // the steps of compute()
   void begin_step(int eflag, int vflag);
   void type_scales();

@@ -9,7 +9,7 @@ powder deck as shipped).  The short command
 of each example is defined once, in EXAMPLES below; the reference log examples/NAME/
 log.<date>.NAME.g++.<K> holds the thermo output of the same command (--write-reference writes
 it), except for the powder, whose log is of the full deck and is compared at the steps both
-print (see EXAMPLES).  --simd PATH runs with GCFMM_SIMD=PATH (exit status 77 when the CPU has
+print (see EXAMPLES).  --simd PATH runs with GCSIMD_MAX_PATH=PATH (exit status 77 when the CPU has
 no such path).
 
 Compared: every thermo block (the rows between a "Step ..." header and "Loop time"), at every
@@ -40,7 +40,7 @@ The powder across machines (powder, powder-full; --simd PATH runs on one SIMD pa
   from a hardware estimate refined by Newton steps on AVX2 and AVX-512, exactly on the generic
   path, and sum in another order), so a machine without AVX-512 does not repeat the reference
   log, which is of the AVX-512 path, bit for bit.  Measured on one machine, the full deck on
-  each path (GCFMM_SIMD=avx512|avx2|generic, thermo every 600 steps at 17 digits, positions
+  each path (GCSIMD_MAX_PATH=avx512|avx2|generic, thermo every 600 steps at 17 digits, positions
   dumped every 600 steps; relative differences to the AVX-512 run):
     - without fix coul/fmm the three paths give identical positions and velocities at every
       dump of the 60000 steps: pair_style granular with the package's sub-models and the wall
@@ -234,7 +234,7 @@ def main():
     ap.add_argument("--mpiexec", default="mpirun")
     ap.add_argument("--workdir", default=None)
     ap.add_argument("--simd", choices=SIMD_PATHS, default=None,
-                    help="run on this SIMD path of the package (GCFMM_SIMD); exit status 77 "
+                    help="run on this SIMD path of the package (GCSIMD_MAX_PATH); exit status 77 "
                          "(skipped) when the CPU does not have it")
     ap.add_argument("--write-reference", action="store_true")
     a = ap.parse_args()
@@ -248,7 +248,7 @@ def main():
         if not cpu_has(a.simd):
             print(f"skipped: this CPU has no {a.simd} path")
             return SKIPPED
-        env["GCFMM_SIMD"] = a.simd
+        env["GCSIMD_MAX_PATH"] = a.simd
     work = os.path.abspath(a.workdir or f"example-{a.example}-{a.np}" +
                            (f"-{a.simd}" if a.simd else ""))
     shutil.rmtree(work, ignore_errors=True)
@@ -260,7 +260,7 @@ def main():
         if a.np > 1:
             cmd = [a.mpiexec, "-np", str(a.np), "--oversubscribe"] + cmd
         cmd += args
-        print("running:", (f"GCFMM_SIMD={a.simd} " if a.simd else "") + " ".join(cmd), flush=True)
+        print("running:", (f"GCSIMD_MAX_PATH={a.simd} " if a.simd else "") + " ".join(cmd), flush=True)
         r = subprocess.run(cmd, cwd=work, env=env)
         if r.returncode != 0:
             print(f"run failed with status {r.returncode}; see {log}")

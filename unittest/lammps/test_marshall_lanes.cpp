@@ -15,7 +15,7 @@
    must be equal bit for bit. Checked: scaling the tangential stiffness of lane 3 by
    (1 + 1e-15) in the lanes kernel (the body every path compiles) fails
    SameBitsAsScalarOnEveryPath. GenericPathSameRunAsDefault compares two paths with each other
-   in a LAMMPS run (the bed with GCFMM_SIMD=generic and with the default path: the same dump
+   in a LAMMPS run (the bed with GCSIMD_MAX_PATH=generic and with the default path: the same dump
    of positions, velocities, forces and torques to the last digit).
 */
 #include "marshall_lanes.h"
@@ -304,7 +304,7 @@ TEST(MarshallLanes, ContactsCoverEveryBranch)
 }
 
 #ifdef GC_LMP_EXECUTABLE
-// the settled paper-size bed run on with granular/opt: the dump of GCFMM_SIMD=generic is that
+// the settled paper-size bed run on with granular/opt: the dump of GCSIMD_MAX_PATH=generic is that
 // of the default path, to the last digit
 std::string run_bed(const std::string &simd, const std::string &tag)
 {
@@ -322,8 +322,8 @@ std::string run_bed(const std::string &simd, const std::string &tag)
   std::string line, step;
   std::getline(f, line);
   std::getline(f, step);
-  const std::string cmd = (simd.empty() ? std::string("env -u GCFMM_SIMD ")
-                                        : "env GCFMM_SIMD=" + simd + " ") +
+  const std::string cmd = (simd.empty() ? std::string("env -u GCSIMD_MAX_PATH -u GCFMM_SIMD ")
+                                        : "env GCSIMD_MAX_PATH=" + simd + " ") +
       GC_LMP_EXECUTABLE + " -log none -echo none -screen none -nocite -in " + dir +
       "/bench/kernels/in.bed -var dump " + input + " -var step " + step +
       " -var steps 200 -var pair granular/opt -var forces " + dump;
@@ -340,7 +340,7 @@ TEST(MarshallLanes, GenericPathSameRunAsDefault)
 {
   const std::string generic = run_bed("generic", "generic");
   const std::string best = run_bed("", "default");
-  ASSERT_FALSE(generic.empty()) << "the bed run with GCFMM_SIMD=generic failed";
+  ASSERT_FALSE(generic.empty()) << "the bed run with GCSIMD_MAX_PATH=generic failed";
   ASSERT_FALSE(best.empty()) << "the bed run on the default path failed";
   EXPECT_TRUE(generic == best) << "the generic and the default path wrote different dumps";
 }

@@ -19,6 +19,8 @@ gc_lammps_test(test_coul_fmm_polarize NP 1 2 SOURCES test_coul_fmm_polarize.cpp)
 gc_lammps_test(test_wall_gran_opt NP 1 2 SOURCES test_wall_gran_opt.cpp)
 # which sleepers fix sleep/gran wakes, on every processor grid of 1, 2 and 3 ranks
 gc_lammps_test(test_sleep_wake NP 1 2 3 SOURCES test_sleep_wake.cpp)
+# fix sleep/gran with granular and granular/opt: the same trajectory, on 1 and 3 ranks
+gc_lammps_test(test_sleep_styles NP 1 3 SOURCES test_sleep_styles.cpp)
 # warnings for inputs LAMMPS accepts that give another answer than meant (read from the log)
 gc_lammps_test(test_silent_mistakes NP 1 2 SOURCES test_silent_mistakes.cpp)
 gc_lammps_test(test_granular_opt_switch SOURCES test_granular_opt_switch.cpp)
@@ -28,7 +30,7 @@ add_dependencies(test_granular_opt_switch lmp)
 # stops the rank that owns it)
 gc_lammps_test(test_coul_fmm_input_checks SOURCES test_coul_fmm_input_checks.cpp)
 # the Marshall contacts in SIMD lanes against the scalar kernel on every path the CPU has, and
-# a bed run with GCFMM_SIMD=generic against the default path (separate lmp processes: the path
+# a bed run with GCSIMD_MAX_PATH=generic against the default path (separate lmp processes: the path
 # is chosen once per process). Bit for bit, so compiled as marshall_lanes.cpp is.
 gc_lammps_test(test_marshall_lanes SOURCES test_marshall_lanes.cpp)
 target_include_directories(test_marshall_lanes PRIVATE ${CMAKE_SOURCE_DIR}/src/simd/include)

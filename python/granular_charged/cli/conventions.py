@@ -24,12 +24,13 @@ def register(subparsers):
 def run(a) -> int:
     # the study loads pandas and matplotlib: imported when the command runs, so that the command line
     # answers --help and argument errors without it
+    from ..analysis.conventions import case_table, run_frame
     from ..figures.conventions import phi0_question
     from ..studies import conventions
     out, params, results = fixed_study.checked_study(a, "conventions", conventions.study_params)
     if not results:
         return 1
-    t = conventions.case_table(conventions.run_frame(results))
+    t = case_table(run_frame(results))
     c = conventions.checks(t)
     t.to_csv(out / "conventions.csv", index=False)
     c.to_csv(out / "conventions_checks.csv", index=False)

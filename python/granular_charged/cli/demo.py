@@ -5,6 +5,7 @@ import argparse
 
 from ..run.runner import Runner
 from . import options
+from .figures import draw_study
 
 DESCRIPTION = """A REDUCED version of the paper's Fig. 2 study, in one folder:
 depositions with r_p = 2 um, U_0 = 1 m/s, gamma = 10 mJ/m^2 and q = 0, 260, 400 e0 (the paper's
@@ -45,6 +46,7 @@ def run(a) -> int:
     for p in study.params(True):
         Runner.check(p, study.tracer(p))
     res = study.run(options.runner(a, not a.no_render))
+    draw_study(res, study.jobs)
     print(report(res, study))
     if a.claims:
         print()

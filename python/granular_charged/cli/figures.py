@@ -1,8 +1,10 @@
 """``granular-charged figures``: the figures and summary table of finished runs (also drawn by
-``sweep --figures``)."""
+``sweep --figures``); the figures of the studies ``demo`` and ``reproduce`` (draw_study) and of
+a study file (draw_study_file)."""
 from __future__ import annotations
 
 import logging
+import time
 from pathlib import Path
 
 from ..run.after_formation import load_table2
@@ -43,6 +45,26 @@ def draw(results, out: Path, t2dir: Path | None, variant: str | None = None):
     paths = all_figures(results, out, rows)
     log.info("%d figures in %s", len(paths), out.resolve())
     return paths
+
+
+def draw_study(res: dict, jobs: int) -> None:
+    """The figures of a study's result (Study.run) in its out/figures, by `jobs` processes:
+    their paths in res["figures"], their drawing time added to res["wall_s"] (the study's wall
+    time is that of the whole command)."""
+    from ..figures.plan import all_figures
+    t0 = time.monotonic()
+    res["figures"] = all_figures(res["results"], Path(res["out"]) / "figures", res["table2_rows"],
+                                 jobs=jobs)
+    res["wall_s"] += time.monotonic() - t0
+
+
+def draw_study_file(res: dict) -> None:
+    """The figures of a study file's result (studyfile.run) in its out/figures, labelled with
+    its name: their paths in res["figures"] (none without finished runs)."""
+    from ..figures.studyfile import study_figures
+    d = res["study"]
+    res["figures"] = (study_figures(d, res["results"], Path(d["out"]) / "figures")
+                      if res["results"] else [])
 
 
 def run(a) -> int:

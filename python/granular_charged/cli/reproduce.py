@@ -6,6 +6,7 @@ from pathlib import Path
 
 from ..run.runner import Runner
 from . import options
+from .figures import draw_study
 
 DESCRIPTION = """The paper's scaling claims tested in this model, resumable:
 the charge series q = 0, 100, 200, 260, 300, 400, 450 e0 at the Fig. 2 case (phi_0/phi - 1 vs
@@ -46,6 +47,7 @@ def run(a) -> int:
     for p in study.params(True):
         Runner.check(p, study.tracer(p))
     res = study.run(options.runner(a, not a.no_render))
+    draw_study(res, study.jobs)
     text = report(res, study)
     (Path(res["out"]) / "report.txt").write_text(text + "\n")
     print(text)

@@ -5,6 +5,7 @@ from pathlib import Path
 
 from ..studies.axes import announce
 from . import options
+from .figures import draw_study_file
 
 
 def register(subparsers):
@@ -31,6 +32,7 @@ def run(a) -> int:
         announce(studyfile.params(d), Path(d["out"]) / "runs", d["protocol"])
         return 0
     res = studyfile.run(a.file, options.runner(a, not a.no_render), engine=options.engine(a))
+    draw_study_file(res)
     print(res["summary"].to_string(index=False))
     for f in res["figures"]:
         print(f)

@@ -11,7 +11,7 @@ import pandas as pd
 
 from .. import paper
 from ..analysis import claims
-from ..studies.conventions import KEYS, MEASURES, PHI_DEFINITIONS, TABLE2_CASE, Z_DEFINITIONS
+from ..analysis.conventions import KEYS, MEASURES, PHI_DEFINITIONS, Z_DEFINITIONS
 from .base import PAPER_STYLE, finished, new_figure, paper_notes, save
 
 log = logging.getLogger(__name__)
@@ -97,7 +97,8 @@ def phi0_question(t: pd.DataFrame, out) -> Path | None:
         if k == 0:
             ax.legend(fontsize=6)
     ax = fig.add_subplot(1, len(PHI_DEFINITIONS) + 1, len(PHI_DEFINITIONS) + 1)
-    fig2 = neutral[np.isclose(neutral["rp_um"], TABLE2_CASE[0]) & np.isclose(neutral["U0"], TABLE2_CASE[1])]
+    fig2 = neutral[np.isclose(neutral["rp_um"], paper.TABLE2_CASE[0])
+                   & np.isclose(neutral["U0"], paper.TABLE2_CASE[1])]
     fig2 = fig2.sort_values("theta_crit")
     ax.axhline(paper.TABLE2[0][2], color="k", ls="--", label=f"paper Table 2: {paper.TABLE2[0][2]}")
     for name, col in Z_DEFINITIONS.items():

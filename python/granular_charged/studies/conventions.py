@@ -32,22 +32,17 @@ import numpy as np
 import pandas as pd
 
 from .. import paper
-from ..analysis import measures, tables
+from ..analysis import tables
+from ..analysis.conventions import PHI_DEFINITIONS, Z_DEFINITIONS
 from ..params import DepositionParams
 
 GAMMA = 0.010
 # (r_p [m], U_0 [m/s], q [e_0]): the three neutral series of the paper's Fig. 3, then the
 # charged Fig. 2 case
 CASES = ((2e-6, 1.0, 0.0), (1e-6, 1.0, 0.0), (1e-6, 2.0, 0.0), (2e-6, 1.0, 400.0))
-TABLE2_CASE = (2.0, 1.0)          # (r_p [um], U_0 [m/s]) of Table 2 and Fig. 2
 CHARGED_Q = 400.0
 ROLLING = (0.01, 0.02, 0.04)      # theta_crit: the deck's default, x 2, x 4
-PHI_DEFINITIONS = {"slab": "phi", "bed, H_p = mean surface": "phi_bed_surface",
-                   "bed, H_p = highest top": "phi_bed_top"}
-Z_DEFINITIONS = {"slab": "Z", "all particles": "Z_all"}
 TOLERANCE_SD = 2.0
-MEASURES = ("phi", "Z", "phi_bed_surface", "phi_bed_top", "Z_all")
-KEYS = ["theta_crit", "rp_um", "U0", "q"]
 
 
 def study_params(seeds=(1, 2, 3), N: int = 2000, rolling=ROLLING, extra=None,
@@ -57,33 +52,6 @@ def study_params(seeds=(1, 2, 3), N: int = 2000, rolling=ROLLING, extra=None,
     return [DepositionParams(rp=rp, U0=u0, gamma=GAMMA, q=q, N=N, seed=s, theta_crit=th,
                              extra=dict(extra or {}), **(fields or {}))
             for th in rolling for rp, u0, q in CASES for s in seeds]
-
-
-def run_frame(results: list[dict]) -> pd.DataFrame:
-    """One row per finished run: its case, theta_crit, seed and the five measures (the
-    whole-bed ones from measures.json, computed once per run)."""
-    rows = []
-    for r in results:
-        p = r["params"]
-        m = measures.load(r["dir"], r)
-        rows.append({"theta_crit": float(p.get("theta_crit", 0.01)), "rp_um": p["rp"] * 1e6,
-                     "U0": p["U0"], "q": p["q"], "seed": p["seed"], "phi": r.get("phi"),
-                     "Z": r.get("Z"), **{k: m.get(k, np.nan) for k in MEASURES[2:]},
-                     "cpu_s": r.get("cpu_s", np.nan)})
-    df = pd.DataFrame(rows, columns=KEYS + ["seed", *MEASURES, "cpu_s"])
-    for c in (*MEASURES, "cpu_s"):
-        df[c] = pd.to_numeric(df[c], errors="coerce")
-    return df
-
-
-def case_table(runs: pd.DataFrame) -> pd.DataFrame:
-    """Per (theta_crit, case): runs, and mean, sd and count of every measure over the seeds."""
-    agg = {"runs": ("seed", "count"), "cpu_s": ("cpu_s", "mean")}
-    for c in MEASURES:
-        agg[c] = (c, "mean")
-        agg[f"{c}_sd"] = (c, "std")
-        agg[f"{c}_n"] = (c, "count")
-    return runs.groupby(KEYS, as_index=False).agg(**agg)
 
 
 def _case(t: pd.DataFrame, theta, rp_um, u0, q):
@@ -115,7 +83,7 @@ def checks(t: pd.DataFrame) -> pd.DataFrame:
     for th, (phi_name, phi_col), (z_name, z_col) in itertools.product(
             thetas, PHI_DEFINITIONS.items(), Z_DEFINITIONS.items()):
         row = {"theta_crit": th, "phi_definition": phi_name, "Z_definition": z_name}
-        fig2 = _case(t, th, *TABLE2_CASE, 0.0)
+        fig2 = _case(t, th, *paper.TABLE2_CASE, 0.0)
         if fig2 is not None:
             row.update(phi0=fig2[phi_col], phi0_sd=fig2[f"{phi_col}_sd"], Z0=fig2[z_col],
                        Z0_sd=fig2[f"{z_col}_sd"],
@@ -134,7 +102,7 @@ def checks(t: pd.DataFrame) -> pd.DataFrame:
         row["phi0_min"] = min(series) if series else np.nan
         row["phi0_max"] = max(series) if series else np.nan
         row["range_dev"] = max(outside) if outside and np.all(np.isfinite(outside)) else np.nan
-        charged = _case(t, th, *TABLE2_CASE, CHARGED_Q)
+        charged = _case(t, th, *paper.TABLE2_CASE, CHARGED_Q)
         if fig2 is not None and charged is not None:
             e, se = tables.expansion_and_se(
                 fig2[phi_col], fig2[f"{phi_col}_sd"] / np.sqrt(fig2[f"{phi_col}_n"]),

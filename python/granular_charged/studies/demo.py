@@ -28,8 +28,8 @@ FULL_COMMAND = "granular-charged reproduce --size paper --jobs 2 --out paper-siz
 
 @dataclass
 class Demo(Study):
-    """The reduced Fig. 2 study: depositions for each q and seed, the Table 2 check, tables,
-    figures (the skeleton is :meth:`Study.run`)."""
+    """The reduced Fig. 2 study: depositions for each q and seed, the Table 2 check, tables
+    (the skeleton is :meth:`Study.run`; the command line draws the figures)."""
     N: int = 500
     qs: tuple = (0.0, 260.0, 400.0)
     extra: dict = field(default_factory=lambda: dict(DEMO_VARS))

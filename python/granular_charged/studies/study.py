@@ -1,8 +1,9 @@
 """One runner for the studies of the command line (``demo`` and ``reproduce``): the depositions
 of a list of cases and seeds (a resumable sweep), runs.csv and summary.csv, the Table 2 check on
-the first neutral packing of the Fig. 2 case (or on each, :meth:`Study.table2_seeds`), and
-the figures, all in one folder: one workflow of the engine (granular_charged.studies.engine), in which
-the Table 2 runs start as soon as their packing is there, beside the remaining depositions.
+the first neutral packing of the Fig. 2 case (or on each, :meth:`Study.table2_seeds`), all in
+one folder: one workflow of the engine (granular_charged.studies.engine), in which the Table 2
+runs start as soon as their packing is there, beside the remaining depositions. The command
+line draws the figures of the result in the same folder (granular_charged.cli.figures).
 
 A study says which runs it wants (:meth:`Study.params`), which particle to follow
 (:meth:`Study.tracer`), the charges of its Table 2 check (:meth:`Study.table2_charges`) and what
@@ -17,7 +18,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..analysis import tables
-from ..figures.plan import all_figures
 from ..params import DepositionParams
 from ..run.after_formation import load_table2
 from ..run.runner import Runner
@@ -32,8 +32,8 @@ FIG2_CASE = {"rp": DepositionParams.rp, "U0": DepositionParams.U0,
 
 
 def table2_folder(out: Path, seed: int | None) -> Path:
-    """Where the Table 2 check of a packing goes: table2/ for the first packing (as before
-    several were checked), table2-s<seed>/ for the others."""
+    """Where the Table 2 check of a packing goes: table2/ for the first packing (so a study
+    that checks one packing has table2/ alone), table2-s<seed>/ for the others."""
     return Path(out) / ("table2" if seed is None else f"table2-s{seed}")
 
 
@@ -47,7 +47,7 @@ def table2_folders(out: Path) -> list[Path]:
 
 @dataclass
 class Study:
-    """Depositions for cases and seeds, then tables, the Table 2 check and the figures."""
+    """Depositions for cases and seeds, then tables and the Table 2 check."""
     out: Path
     seeds: tuple = (1, 2, 3)
     table2_qs: tuple = (0.0, 260.0, 400.0)
@@ -112,7 +112,6 @@ class Study:
                "have_fmm": have_fmm, **self.analyse(runs, summ, out, results)}
         res["table2"] = tables.table2_frame(t2) if t2 else None
         res["table2_rows"] = t2
-        res["figures"] = all_figures(results, out / "figures", t2, jobs=self.jobs)
         res["wall_s"] = time.monotonic() - t0
         res["complete"] = len(results) == len(params)
         res["missing"] = len(params) - len(results)

@@ -3,9 +3,9 @@
 The file names the material(s), the population, the protocol, the grid and the seeds
 (doc/populations.md, "Study files"); every combination of the grid's values and the seeds is
 one run of in.deposition (resumable: finished runs are skipped), then the tables (runs.csv,
-summary.csv, classes.csv per species and size class) and the figures (phi and <Z> against each
-grid axis, f(Z), g(r) in units of the mean diameter and of r_i + r_j), labelled with the
-study's name. No value or annotation of the paper appears in them.
+summary.csv, classes.csv per species and size class), labelled with the study's name. The
+command line draws the figures (granular_charged.figures.studyfile). No value or annotation of
+the paper appears in them.
 """
 from __future__ import annotations
 
@@ -14,9 +14,7 @@ import logging
 import tomllib
 from pathlib import Path
 
-
 from ..analysis.studytables import study_tables
-from ..figures.studyfile import study_figures
 from ..params import DepositionParams, ParamError, param_names
 from ..run import population
 from ..run.runner import RESERVED
@@ -155,7 +153,7 @@ def params(d: dict) -> list[DepositionParams]:
 
 
 def run(path, runner, jobs: int = 1, progress: bool = True, engine=None) -> dict:
-    """Run a study file: the runs (resumable), then tables and figures under its out folder."""
+    """Run a study file: the runs (resumable), then the tables under its out folder."""
     d = load(path)
     ps = params(d)
     for p in ps:
@@ -166,6 +164,5 @@ def run(path, runner, jobs: int = 1, progress: bool = True, engine=None) -> dict
     results = Sweep(runner, out / "runs", jobs=jobs, progress=progress, engine=engine).run(ps)
     out.mkdir(parents=True, exist_ok=True)
     runs, summ = study_tables(d, results, out)
-    figs = study_figures(d, results, out / "figures") if results else []
-    return {"study": d, "results": results, "runs": runs, "summary": summ, "figures": figs,
+    return {"study": d, "results": results, "runs": runs, "summary": summ,
             "complete": len(results) == len(ps)}

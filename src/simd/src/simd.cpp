@@ -5,8 +5,6 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "gcsimd/simd_paths.hpp"
-
 namespace gcsimd {
 
 bool simd_path_available(SimdPath path) {
@@ -27,7 +25,9 @@ bool simd_path_available(SimdPath path) {
 
 SimdPath default_simd_path() {
   SimdPath cap = SimdPath::AVX512;
-  if (const char *e = std::getenv("GCFMM_SIMD")) {
+  const char *e = std::getenv(kMaxPathVariable);
+  if (!e) e = std::getenv(kMaxPathVariableAlias);
+  if (e) {
     if (!std::strcmp(e, "generic")) cap = SimdPath::Generic;
     else if (!std::strcmp(e, "avx2")) cap = SimdPath::AVX2;
   }

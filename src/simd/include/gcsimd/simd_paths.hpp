@@ -6,12 +6,10 @@
 
 #include "gcsimd/simd.hpp"
 
-#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
-#define GCSIMD_X86_DISPATCH 1
+#if GCSIMD_X86_DISPATCH
 #define GCSIMD_TARGET_AVX2 __attribute__((target("avx2,fma")))
 #define GCSIMD_TARGET_AVX512 __attribute__((target("avx512f,avx512dq,avx2,fma")))
 #else
-#define GCSIMD_X86_DISPATCH 0
 #define GCSIMD_TARGET_AVX2
 #define GCSIMD_TARGET_AVX512
 #endif
