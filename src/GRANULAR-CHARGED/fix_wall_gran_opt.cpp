@@ -12,20 +12,20 @@
 #include "atom.h"
 #include "comm.h"
 #include "domain.h"
-#include "gran_sub_mod.h"
 #include "granular_model.h"
-#include "math_extra.h"
+#include "marshall_lanes.h"
 #include "update.h"
 
 #if GC_LAMMPS_VERSION >= 20260704
 #include "fix_wall.h"
 #endif
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 
 using namespace LAMMPS_NS;
 using namespace Granular_NS;
-using namespace MathExtra;
 namespace MK = MarshallKernels;
 
 // FixWallGran's wall styles (fix_wall_gran.cpp: "XYZ PLANE need to be 0,1,2") and its value of
@@ -71,6 +71,9 @@ void FixWallGranOpt::init()
   if (fused && (coeffs.hist_tangential < 1 || coeffs.hist_tangential + 3 > size_history))
     fused = false;
   scales_radius = -1.0;
+  // at a wall both rolling conventions limit xi at theta_crit R_eff = theta_crit r_p
+  wall_coeffs = coeffs;
+  wall_coeffs.roll_radius_factor = 1.0;
 
   if (comm->me == 0 && !reported) {
     utils::logmesg(lmp, "fix {} (wall/gran/opt): {}\n", id,
@@ -104,141 +107,147 @@ const MK::JKRScales &FixWallGranOpt::scales_of(double reff)
 }
 
 /* ----------------------------------------------------------------------
-   FixWallGran::post_force() for a still flat wall, with what GranularModel::check_contact()
-   and calculate_forces() do for a WALL contact of the Marshall set (the sub-models'
-   marshall_kernels.h calls) in the same order of operations: the wall is a body of radius 0
-   at rest (R_eff = r_p, v_wall = omega_wall = 0, meff = m_i), the torque's lever arm r_p.
-   Same history values at the same offsets, reset when a contact ends.
+   FixWallGran::post_force() for a still flat wall: GranularModel::check_contact() and
+   calculate_forces() of a WALL contact of the Marshall set, by the contact assembly of
+   pair_style granular/opt (marshall_lanes.h) with the wall as a fixed partner of radius 0 at
+   rest (R_eff = r_p, v_wall = omega_wall = 0, m* = m_i, torque lever arm r_p). Same history
+   values at the same offsets, reset when a contact ends. The adhesive contacts go through the
+   SIMD lanes, those of Hertz's law (no adhesion) through the scalar instantiation.
 ------------------------------------------------------------------------- */
 
 void FixWallGranOpt::post_force_fused()
 {
+  namespace ML = MarshallLanes;
   // do not update history during setup
   history_update = update->setupflag ? 0 : 1;
   model->history_update = history_update;
 
+  gather_contacts();
+  jkr_root.resize(jkr_overlap.size());
+  JKRScaled::roots(jkr_overlap.size(), jkr_overlap.data(), jkr_root.data());
+
+  const std::size_t n = contacts.size();
+  if (coeffs.gamma == 0.0) {
+    for (const WallContact &c : contacts) {
+      double in[ML::N_INPUT], out[ML::N_OUTPUT];
+      pack_contact(c, 1.0, in, 1);
+      ML::marshall_contact(in, out, history_update);
+      unpack_contact(c, out, 1);
+    }
+  } else {
+    // a chunk at a time: its lanes blocks stay in the L1 cache
+    constexpr std::size_t CHUNK = 8 * ML::WIDTH;
+    lane_in.resize(CHUNK * ML::N_INPUT);
+    lane_out.resize(CHUNK * ML::N_OUTPUT);
+    for (std::size_t start = 0; start < n; start += CHUNK) {
+      const std::size_t m = std::min(CHUNK, n - start);
+      for (std::size_t k = 0; k < m; k++)
+        pack_contact(contacts[start + k], jkr_root[start + k], ML::lane_input(lane_in.data(), k),
+                     ML::WIDTH);
+      const std::size_t nblocks = ML::pad_last_block(lane_in.data(), m);
+      ML::contacts_in_lanes(nblocks, lane_in.data(), lane_out.data(), history_update);
+      for (std::size_t k = 0; k < m; k++)
+        unpack_contact(contacts[start + k], ML::lane_output(lane_out.data(), k), ML::WIDTH);
+    }
+  }
+
+#if GC_LAMMPS_VERSION >= 20260704
+  // the wall's image for dump image (FixWallGran::post_force)
+  const int axis = wallstyle;
+  int m = 0;
+  const int lo_side[3] = {FixWall::XLO, FixWall::YLO, FixWall::ZLO};
+  const int hi_side[3] = {FixWall::XHI, FixWall::YHI, FixWall::ZHI};
+  if (lo != -BIG) FixWall::update_image_plane(m++, lo_side[axis], lo, imgparms, domain);
+  if (hi != BIG) FixWall::update_image_plane(m++, hi_side[axis], hi, imgparms, domain);
+#endif
+}
+
+/* ----------------------------------------------------------------------
+   the contact life of each atom of the group (GranularModel::check_contact, jkr/marshall
+   touch, R_eff = radsum = r_p): a contact that ends has its history reset; a touching one is
+   kept with, if adhesive, its scaled overlap
+------------------------------------------------------------------------- */
+
+void FixWallGranOpt::gather_contacts()
+{
   const double wlo = lo;
   const double whi = hi;
   const int axis = wallstyle;
-  const double vwall[3] = {0.0, 0.0, 0.0};
-  const double w0[3] = {0.0, 0.0, 0.0};
-  const double rwall = 0.0;
-
   double **x = atom->x;
-  double **v = atom->v;
-  double **f = atom->f;
-  double **omega = atom->omega;
-  double **torque = atom->torque;
-  double *radius = atom->radius;
-  double *rmass = atom->rmass;
-  int *mask = atom->mask;
+  const double *radius = atom->radius;
+  const int *mask = atom->mask;
   const int nlocal = atom->nlocal;
   const int nhistory = size_history;
-  const double dtm = model->dt;
-  const MarshallFusedSet::Coeffs &c = coeffs;
+  const bool adhesive = coeffs.gamma != 0.0;
+  contacts.clear();
+  jkr_overlap.clear();
 
   for (int i = 0; i < nlocal; i++) {
     if (!(mask[i] & groupbit)) continue;
 
     // signed distance from the nearer plane, along the wall's axis
-    double dx[3] = {0.0, 0.0, 0.0};
     const double del1 = x[i][axis] - wlo;
     const double del2 = whi - x[i][axis];
-    if (del1 < del2)
-      dx[axis] = del1;
-    else
-      dx[axis] = -del2;
+    const double dist = del1 < del2 ? del1 : -del2;
 
-    // contact life (GranularModel::check_contact, jkr/marshall touch): R_eff = radsum = r_p
     double *history = history_one[i];
     const bool was_touching = history[0] != 0.0;
-    const double rsq = lensq3(dx);
-    const double radi = radius[i];
-    const double radsum = radi;
+    const double rsq = dist * dist;
+    const double radsum = radius[i];
     // most atoms are far from the wall: rejected before the JKR scales
     bool touching = rsq < radsum * radsum;
-    if (was_touching) touching = MK::jkr_touch(true, rsq, radsum, scales_of(radi).deltac);
+    if (was_touching) touching = MK::jkr_touch(true, rsq, radsum, scales_of(radsum).deltac);
     if (!touching) {
       for (int k = 0; k < nhistory; k++) history[k] = 0.0;
       continue;
     }
     history[0] = 1;
-
-    const double reff = radi;
-    const MK::JKRScales &sc = scales_of(reff);
-    const double meff = rmass[i];
-
-    // kinematics (GranularModel::calculate_forces)
-    const double r = sqrt(rsq);
-    const double rinv = 1.0 / r;
-    const double delta = radsum - r;
-    double vr[3], nx[3], vn[3], vt[3], wr[3], temp[3], vtr[3];
-    sub3(v[i], vwall, vr);
-    scale3(rinv, dx, nx);
-    const double vnnr = dot3(vr, nx);
-    scale3(vnnr, nx, vn);
-    sub3(vr, vn, vt);
-    scaleadd3(radi, omega[i], rwall, w0, wr);
-    cross3(wr, nx, temp);
-    sub3(vt, temp, vtr);
-
-    // normal: JKR with Marshall damping
-    const MK::NormalForce nf = MK::jkr_normal_force(sc, c.gamma, c.emix, delta, reff);
-    const double damp_prefactor =
-        MK::damping_prefactor(c.alpha, MK::damping_sqrt_mass(c.mass_factor, meff), nf);
-    const double fntot = nf.fne + (-damp_prefactor * vnnr);
-    const double fncrit = MK::critical_force(nf);
-
-    // sliding
-    double fs[3];
-    MK::tangential_force(&history[c.hist_tangential], nx, vtr, dtm, c.k_t * nf.a, damp_prefactor,
-                         fncrit * c.mu, history_update, fs);
-
-    double forces[3], torquesi[3];
-    scale3(fntot, nx, forces);
-    add3(forces, fs, forces);
-    cross3(nx, fs, torquesi);
-    scale3(-1, torquesi);
-    scale3(radi, torquesi);
-
-    if (c.rolling || c.twisting) {
-      double relrot[3];
-      sub3(omega[i], w0, relrot);
-      if (c.rolling) {
-        // rolling velocity, eq. 31 of Wang et al, Particuology 23, 49 (2015); at a wall both
-        // rolling conventions limit xi at theta_crit R_eff = theta_crit r_p
-        double vrl[3], fr[3], torroll[3];
-        vrl[0] = reff * (relrot[1] * nx[2] - relrot[2] * nx[1]);
-        vrl[1] = reff * (relrot[2] * nx[0] - relrot[0] * nx[2]);
-        vrl[2] = reff * (relrot[0] * nx[1] - relrot[1] * nx[0]);
-        MK::rolling_force(&history[c.hist_rolling], nx, vrl, dtm, c.theta_crit * reff,
-                          nf.adhesive / reff, history_update, fr);
-        cross3(nx, fr, torroll);
-        scale3(reff, torroll);
-        add3(torquesi, torroll, torquesi);
-      }
-      if (c.twisting) {
-        // omega_T (eq. 29 of Marshall 2009)
-        const double magtwist = dot3(relrot, nx);
-        const double moment = MK::twisting_moment(history[c.hist_twisting], magtwist, dtm, nf.a,
-                                                  c.k_t, damp_prefactor, c.mu * fncrit,
-                                                  history_update);
-        double tortwist[3];
-        scale3(moment, nx, tortwist);
-        add3(torquesi, tortwist, torquesi);
-      }
-    }
-
-    add3(f[i], forces, f[i]);
-    add3(torque[i], torquesi, torque[i]);
+    contacts.push_back({i, dist});
+    if (adhesive) jkr_overlap.push_back(MK::scaled_overlap(scales_of(radsum), radsum - sqrt(rsq)));
   }
+}
 
-#if GC_LAMMPS_VERSION >= 20260704
-  // the wall's image for dump image (FixWallGran::post_force)
-  int m = 0;
-  const int lo_side[3] = {FixWall::XLO, FixWall::YLO, FixWall::ZLO};
-  const int hi_side[3] = {FixWall::XHI, FixWall::YHI, FixWall::ZHI};
-  if (lo != -BIG) FixWall::update_image_plane(m++, lo_side[axis], wlo, imgparms, domain);
-  if (hi != BIG) FixWall::update_image_plane(m++, hi_side[axis], whi, imgparms, domain);
-#endif
+/* ----------------------------------------------------------------------
+   the inputs of contact c (marshall_lanes.h), input q at in[q * stride]: the wall is a fixed
+   partner of radius 0 at rest; root: its JKR root (unused without adhesion)
+------------------------------------------------------------------------- */
+
+void FixWallGranOpt::pack_contact(const WallContact &c, double root, double *in, int stride)
+{
+  namespace ML = MarshallLanes;
+  static constexpr double at_rest[3] = {0.0, 0.0, 0.0};
+  const int i = c.i;
+  const double radi = atom->radius[i];
+  const double *history = history_one[i];
+  double dx[3] = {0.0, 0.0, 0.0};
+  dx[wallstyle] = c.dist;
+  ML::pack_contact_state(in, stride, dx, atom->v[i], at_rest, atom->omega[i], at_rest,
+                         history + coeffs.hist_tangential,
+                         coeffs.rolling ? history + coeffs.hist_rolling : nullptr,
+                         coeffs.twisting ? history + coeffs.hist_twisting : nullptr, root,
+                         atom->rmass[i], 0.0, ML::FIXED_J);
+  ML::pack_contact_model(in, stride, wall_coeffs, model->dt, radi, 0.0, radi, scales_of(radi),
+                         ML::LEVER_SHIFT_WALL);
+}
+
+/* ----------------------------------------------------------------------
+   the results of contact c back (output q at out[q * stride]): its histories (the sub-models
+   it has), the force and the torque on its atom
+------------------------------------------------------------------------- */
+
+void FixWallGranOpt::unpack_contact(const WallContact &c, const double *out, int stride)
+{
+  namespace ML = MarshallLanes;
+  const int i = c.i;
+  double *history = history_one[i];
+  ML::unpack_histories(out, stride, history + coeffs.hist_tangential,
+                       coeffs.rolling ? history + coeffs.hist_rolling : nullptr,
+                       coeffs.twisting ? history + coeffs.hist_twisting : nullptr);
+  double force[3], torque_i[3], torque_j[3];
+  ML::unpack_forces(out, stride, 1.0, force, torque_i, torque_j);
+  double *f = atom->f[i], *torque = atom->torque[i];
+  for (int k = 0; k < 3; k++) {
+    f[k] = f[k] + force[k];
+    torque[k] = torque[k] + torque_i[k];
+  }
 }

@@ -7,9 +7,10 @@
    the GNU General Public License (same terms as LAMMPS).
 ------------------------------------------------------------------------- */
 
-// One Marshall contact of pair_style granular/opt (kinematics, JKR normal force from its root,
-// damping, sliding, rolling, twisting, torques) as a template on the number type of
-// marshall_kernels.h: double for one contact (the scalar kernel, the reference), Lanes for
+// One Marshall contact (kinematics, JKR normal force from its root, damping, sliding, rolling,
+// twisting, torques), the one contact assembly of pair_style granular/opt and fix
+// wall/gran/opt (a wall is a fixed partner of radius 0 at rest), as a template on the number
+// type of marshall_kernels.h: double for one contact (the scalar kernel, the reference), Lanes for
 // WIDTH contacts at once (a GCC vector type, so the vector code needs no auto-vectoriser).
 // Every decision of a contact is a select (the double instantiation computes a value needed on
 // one side only where it is needed: NumberOps::only_where); the only branches of the lanes are
@@ -98,11 +99,16 @@ namespace MarshallLanes {
     TWISTING,            // 1: twisting marshall/jkr defined, 0: none
     HERTZ,               // 1: no adhesion, Hertz's law (the scalar instantiation only)
     EMIX,                // E* (for Hertz's law)
+    LEVER_SHIFT,         // the torque's lever arm is R - LEVER_SHIFT delta: 1/2 between two
+                         // particles, 0 at a wall (dist_to_contact of GranularModel)
     HIST_T,              // tangential history (3)
     HIST_R = HIST_T + 3, // rolling history (3)
     HIST_TW = HIST_R + 3,    // twisting history (1)
     N_INPUT
   };
+  // LEVER_SHIFT of a contact between two particles and of a contact with a wall
+  constexpr double LEVER_SHIFT_PAIR = 0.5, LEVER_SHIFT_WALL = 0.0;
+
   // the outputs of one contact: force on i, torques on i and j (before factor_lj), histories
   enum Output {
     FORCE = 0,
@@ -172,7 +178,7 @@ namespace MarshallLanes {
     for (int k = 0; k < 3; k++) force[k] = fntot * nx[k] + fs[k];
     T nxfs[3];
     MK::cross3(nx, fs, nxfs);
-    const T lever_i = radi - 0.5 * delta, lever_j = radj - 0.5 * delta;
+    const T lever_i = radi - in(LEVER_SHIFT) * delta, lever_j = radj - in(LEVER_SHIFT) * delta;
     for (int k = 0; k < 3; k++) {
       const T t = nxfs[k] * -1.0;
       torque_i[k] = t * lever_i;
@@ -255,11 +261,13 @@ namespace MarshallLanes {
 
   // the inputs of a contact's model and radii, the same for every contact of one model between
   // atoms of the same two radii. Coeffs: MarshallFusedSet::Coeffs (emix, gamma, alpha,
-  // mass_factor, k_t, mu, rolling, theta_crit, roll_radius_factor, twisting)
+  // mass_factor, k_t, mu, rolling, theta_crit, roll_radius_factor, twisting); lever_shift:
+  // LEVER_SHIFT_PAIR or LEVER_SHIFT_WALL
   template <class Coeffs>
   GC_KERNEL_INLINE void pack_contact_model(double *in, int stride, const Coeffs &model, double dt,
                                            double rad_i, double rad_j, double reff,
-                                           const MarshallKernels::JKRScales &scales)
+                                           const MarshallKernels::JKRScales &scales,
+                                           double lever_shift)
   {
     auto put = [in, stride](int q, double value) GC_KERNEL_LAMBDA { in[q * stride] = value; };
     put(RAD_I, rad_i);
@@ -278,6 +286,7 @@ namespace MarshallLanes {
     put(TWISTING, model.twisting ? 1.0 : 0.0);
     put(HERTZ, model.gamma == 0.0 ? 1.0 : 0.0);
     put(EMIX, model.emix);
+    put(LEVER_SHIFT, lever_shift);
   }
 
   // the histories of a contact's sub-models back (null: the model has none)
@@ -310,6 +319,28 @@ namespace MarshallLanes {
                          gcsimd::SimdPath path);
   // the same on the default path (gcsimd::default_simd_path(), capped by GCFMM_SIMD)
   void contacts_in_lanes(std::size_t nblocks, const double *in, double *out, bool history_update);
+
+  // contact l's first input and output in such blocks: its input q at [q * WIDTH]
+  inline double *lane_input(double *in, std::size_t l)
+  {
+    return in + (l / WIDTH) * N_INPUT * WIDTH + l % WIDTH;
+  }
+  inline double *lane_output(double *out, std::size_t l)
+  {
+    return out + (l / WIDTH) * N_OUTPUT * WIDTH + l % WIDTH;
+  }
+  // the lanes from nlanes to the end of its block copy the inputs of the block's first contact
+  // (evaluated, not read back); returns the number of blocks
+  inline std::size_t pad_last_block(double *in, std::size_t nlanes)
+  {
+    const std::size_t nblocks = (nlanes + WIDTH - 1) / WIDTH;
+    for (std::size_t l = nlanes; l < nblocks * WIDTH; l++) {
+      const double *first = lane_input(in, l - l % WIDTH);
+      double *pad = lane_input(in, l);
+      for (int q = 0; q < N_INPUT; q++) pad[q * WIDTH] = first[q * WIDTH];
+    }
+    return nblocks;
+  }
 
 }    // namespace MarshallLanes
 

@@ -12,7 +12,6 @@
 #include "marshall_lanes.h"
 
 #include "atom.h"
-#include "comm.h"
 #include "error.h"
 #include "fix.h"
 #include "fix_charge_check.h"
@@ -20,14 +19,11 @@
 #include "force.h"
 #include "gran_sub_mod.h"
 #include "granular_model.h"
-#include "kspace.h"
 #include "math_extra.h"
-#include "memory.h"
 #include "modify.h"
 #include "neigh_list.h"
 #include "neighbor.h"
 #include "update.h"
-#include "utils.h"
 
 #include <cstddef>
 #include <cmath>
@@ -44,34 +40,12 @@ namespace ML = MarshallLanes;
 
 PairGranularOpt::PairGranularOpt(LAMMPS *lmp) :
     PairGranular(lmp), fused_ready(false), generic_only(true), any_heat(false), ncontacts(0),
-    history_update(true),
-    hist_tangential(0), hist_rolling(0), hist_twisting(0), history_fresh(false),
-    history_fresh_checked(true)
+    history_update(true), hist_tangential(0), hist_rolling(0), hist_twisting(0),
+    history_handover(lmp)
 {
 }
 
-/* ----------------------------------------------------------------------
-   The contact history of granular and granular/opt is one fix NEIGH_HISTORY with the same
-   per-pair values. LAMMPS names it NEIGH_HISTORY_GRANULAR<n> after the pair style's instance
-   (from 4Jul2026 on), and read_restart restores it only into a fix of the stored name: a restart
-   written by one style and read with the other (a new instance) would start every contact
-   afresh. So granular/opt takes over a stored history that no fix has claimed when it creates its
-   own, and, when it is deleted for a style given after read_restart, renames the stored history
-   for the instance created next. Modify keeps the stored entries in protected members; a
-   derived class may form pointers to them.
-------------------------------------------------------------------------- */
-
 namespace {
-struct StoredFixData : Modify {
-  static char **Modify::*ids() { return &StoredFixData::id_restart_peratom; }
-  static char **Modify::*styles() { return &StoredFixData::style_restart_peratom; }
-  static int *Modify::*used() { return &StoredFixData::used_restart_peratom; }
-};
-// the number of contacts (partners) a history holds for each local atom after a run
-struct HistoryPartners : FixNeighHistory {
-  static int *FixNeighHistory::*count() { return &HistoryPartners::npartner; }
-};
-
 // a per-atom 3-vector array of Atom (memory->create: row i at [0] + 3 i) indexed without its row
 // pointers: one dependent load less for each atom a contact touches
 struct AtomRows {
@@ -79,120 +53,24 @@ struct AtomRows {
   explicit AtomRows(double **rows) : first(rows ? rows[0] : nullptr) {}
   double *operator[](int i) const { return first + 3 * static_cast<std::ptrdiff_t>(i); }
 };
-
-// the stored histories of pair styles granular and granular/opt no fix has taken
-[[maybe_unused]] std::vector<int> unclaimed_histories(Modify *modify)
-{
-  std::vector<int> found;
-  char **ids = modify->*StoredFixData::ids();
-  char **styles = modify->*StoredFixData::styles();
-  int *used = modify->*StoredFixData::used();
-  for (int k = 0; k < modify->nfix_restart_peratom; k++)
-    if (!used[k] && strcmp(styles[k], "NEIGH_HISTORY") == 0 &&
-        utils::strmatch(ids[k], "^NEIGH_HISTORY_GRANULAR\\d*$") && !modify->get_fix_by_id(ids[k]))
-      found.push_back(k);
-  return found;
-}
-
-// was fix `id` given its values by the restart file just read (even an empty history)?
-bool restored_from_restart(Modify *modify, const char *id)
-{
-  char **ids = modify->*StoredFixData::ids();
-  int *used = modify->*StoredFixData::used();
-  for (int k = 0; k < modify->nfix_restart_peratom; k++)
-    if (used[k] && strcmp(ids[k], id) == 0) return true;
-  return false;
-}
-
-bigint history_contacts(LAMMPS *lmp, FixNeighHistory *history)
-{
-  const int *count = history->*HistoryPartners::count();
-  bigint mine = 0;
-  for (int i = 0; count && i < lmp->atom->nlocal; i++) mine += count[i];
-  bigint all = 0;
-  MPI_Allreduce(&mine, &all, 1, MPI_LMP_BIGINT, MPI_SUM, lmp->world);
-  return all;
-}
 }    // namespace
 
 PairGranularOpt::~PairGranularOpt()
 {
-  // LAMMPS deletes update before the pair style at its end: then nothing follows this style
-  if (!update) return;
-  if (fix_history) {
-    const bigint lost = history_contacts(lmp, fix_history);
-    if (lost > 0 && comm->me == 0)
-      error->warning(FLERR,
-                     "Pair granular/opt deleted with {} contacts in its history: a pair style "
-                     "defined now starts them afresh (no tangential, rolling or twisting spring, "
-                     "no JKR branch); write_restart, then read_restart and the other style, "
-                     "keeps them",
-                     lost);
-    return;
-  }
-#if GC_LAMMPS_VERSION >= 20260704
-  const auto stored = unclaimed_histories(modify);
-  if (stored.size() == 1) {
-    char *&id = (modify->*StoredFixData::ids())[stored.front()];
-    delete[] id;
-    id = utils::strdup("NEIGH_HISTORY_GRANULAR" + std::to_string(Pair::instance_total));
-  }
-#endif
-}
-
-/* ----------------------------------------------------------------------
-   before the history fix is created: take over the one stored history no fix has claimed if
-   none has this style's name (see the destructor)
-------------------------------------------------------------------------- */
-
-void PairGranularOpt::adopt_restart_history()
-{
-#if GC_LAMMPS_VERSION >= 20260704
-  const auto stored = unclaimed_histories(modify);
-  char **ids = modify->*StoredFixData::ids();
-  for (int k : stored)
-    if (strcmp(ids[k], id_history) == 0) return;
-  if (stored.size() > 1)
-    error->warning(FLERR, "Pair granular/opt: {} contact histories in the restart file, none "
-                   "of this style's name {}: it starts with none", stored.size(), id_history);
-  if (stored.size() != 1) return;
-  delete[] id_history;
-  id_history = utils::strdup(ids[stored.front()]);
-#endif
-}
-
-/* ----------------------------------------------------------------------
-   a history created empty after step 0 on touching pairs (a switch from pair_style granular
-   within one input, or a bed read from a dump): every contact starts afresh, which is a
-   different answer from a run that kept its contacts; say so once
-------------------------------------------------------------------------- */
-
-void PairGranularOpt::warn_fresh_history()
-{
-  history_fresh_checked = true;
-  if (!history_fresh || update->ntimestep == 0) return;
-  bigint mine = static_cast<bigint>(contacts.size()), touching = 0;
-  MPI_Allreduce(&mine, &touching, 1, MPI_LMP_BIGINT, MPI_SUM, world);
-  if (touching > 0 && comm->me == 0)
-    error->warning(FLERR,
-                   "Pair granular/opt starts at step {} with {} touching pairs and no contact "
-                   "history: each starts afresh (no tangential, rolling or twisting spring, the "
-                   "JKR loading branch). A switch from pair_style granular within one input "
-                   "loses the history; a restart read with granular/opt keeps it",
-                   update->ntimestep, touching);
+  history_handover.pair_deleted(fix_history);
 }
 
 /* ---------------------------------------------------------------------- */
 
 void PairGranularOpt::init_style()
 {
+  // the contact history across restarts and switches of style (granular_history_handover.h)
   const bool first_init = fix_history == nullptr;
-  if (first_init) adopt_restart_history();
+#if GC_LAMMPS_VERSION >= 20260704
+  if (first_init) history_handover.adopt_stored_history(id_history);    // named per instance
+#endif
   PairGranular::init_style();
-  if (first_init && fix_history) {
-    history_fresh = !restored_from_restart(modify, fix_history->id);
-    history_fresh_checked = false;
-  }
+  if (first_init) history_handover.history_created(fix_history);
   fused_ready = false;    // init_one() may still mix new models: set up before the first compute
   FixChargeCheck::ensure(lmp);    // charges without a Coulomb solver: warned at init
 }
@@ -215,20 +93,18 @@ bool PairGranularOpt::model_is_fused(int n) const
 void PairGranularOpt::setup_fused()
 {
   fused.assign(nmodels, FusedMarshall());
-  for (int n = 0; n < nmodels; n++) {
-    FusedMarshall &f = fused[n];
-    if (!MarshallFusedSet::of_model(models_list[n], f)) continue;
-    f.on = true;
-    hist_tangential = f.hist_tangential;
-    hist_rolling = f.hist_rolling;
-    hist_twisting = f.hist_twisting;
-  }
-  // a heat model needs PairGranular's heat-flow bookkeeping, which the fused loop does not do
   bool any_fused = false;
   any_heat = false;
   for (int n = 0; n < nmodels; n++) {
-    any_fused = any_fused || fused[n].on;
+    FusedMarshall &f = fused[n];
+    f.on = MarshallFusedSet::of_model(models_list[n], f);
+    any_fused = any_fused || f.on;
+    // a heat model needs PairGranular's heat-flow bookkeeping, which the fused loop does not do
     any_heat = any_heat || models_list[n]->sub_models[HEAT]->name != "none";
+    if (!f.on) continue;
+    hist_tangential = f.hist_tangential;
+    hist_rolling = f.hist_rolling;
+    hist_twisting = f.hist_twisting;
   }
   generic_only = !any_fused || any_heat;
   fused_ready = true;
@@ -256,7 +132,7 @@ void PairGranularOpt::compute(int eflag, int vflag)
   }
   begin_step(eflag, vflag);
   gather_contacts();
-  if (!history_fresh_checked) warn_fresh_history();
+  history_handover.check_fresh_history(static_cast<bigint>(contacts.size()));
   const bigint generic_contacts = generic_i.empty() ? 0 : compute_generic_pairs(eflag, vflag);
   jkr_root.resize(jkr_overlap.size());
   JKRScaled::roots(jkr_overlap.size(), jkr_overlap.data(), jkr_root.data());
@@ -400,10 +276,44 @@ void PairGranularOpt::gather_contacts()
 
 /* ----------------------------------------------------------------------
    the pairs outside the fused set by PairGranular::compute itself, on a neighbor list (and
-   contact flags and histories) holding only them; their flags and histories are copied back
+   contact flags and histories) holding only them; their flags and histories are copied back.
+   Returns the number of those pairs that touch.
 ------------------------------------------------------------------------- */
 
 bigint PairGranularOpt::compute_generic_pairs(int eflag, int vflag)
+{
+  build_generic_list();
+  NeighList *full = list;
+  int **flags = use_history ? fix_history->firstflag : nullptr;
+  double **values = use_history ? fix_history->firstvalue : nullptr;
+  list = generic_list.get();
+  if (use_history) {
+    fix_history->firstflag = generic_firsttouch.data();
+    fix_history->firstvalue = generic_firsthistory.data();
+  }
+  PairGranular::compute(eflag, vflag);
+  list = full;
+  if (!use_history) return 0;
+  fix_history->firstflag = flags;
+  fix_history->firstvalue = values;
+  const int size_hist = get_size_history();
+  bigint touching = 0;
+  for (size_t k = 0; k < generic_i.size(); k++) {
+    const int i = generic_i[k], jj = generic_jj[k];
+    flags[i][jj] = generic_touch[k];
+    touching += generic_touch[k] != 0;
+    std::copy(&generic_history[size_hist * k], &generic_history[size_hist * (k + 1)],
+              &values[i][size_hist * jj]);
+  }
+  return touching;
+}
+
+/* ----------------------------------------------------------------------
+   the neighbor list of the pairs outside the fused set (generic_i, generic_jj) with copies of
+   their contact flags and histories: arrays of this style, in the layout of the full list's
+------------------------------------------------------------------------- */
+
+void PairGranularOpt::build_generic_list()
 {
   const int nall = atom->nlocal + atom->nghost;
   const int size_hist = use_history ? get_size_history() : 0;
@@ -438,29 +348,6 @@ bigint PairGranularOpt::compute_generic_pairs(int eflag, int vflag)
   generic_list->ilist = generic_atoms.data();
   generic_list->numneigh = generic_numneigh.data();
   generic_list->firstneigh = generic_firstneigh.data();
-
-  NeighList *full = list;
-  int **flags = use_history ? fix_history->firstflag : nullptr;
-  double **values = use_history ? fix_history->firstvalue : nullptr;
-  list = generic_list.get();
-  if (use_history) {
-    fix_history->firstflag = generic_firsttouch.data();
-    fix_history->firstvalue = generic_firsthistory.data();
-  }
-  PairGranular::compute(eflag, vflag);
-  list = full;
-  if (!use_history) return 0;
-  fix_history->firstflag = flags;
-  fix_history->firstvalue = values;
-  bigint touching = 0;
-  for (size_t k = 0; k < n; k++) {
-    const int i = generic_i[k], jj = generic_jj[k];
-    flags[i][jj] = generic_touch[k];
-    touching += generic_touch[k] != 0;
-    std::copy(&generic_history[size_hist * k], &generic_history[size_hist * (k + 1)],
-              &values[i][size_hist * jj]);
-  }
-  return touching;
 }
 
 /* ----------------------------------------------------------------------
@@ -481,8 +368,8 @@ void PairGranularOpt::compute_fused_contacts()
   lane_out.resize(CHUNK * ML::N_OUTPUT);
   lane_of.resize(CHUNK);
   // lane l's first input and output: block l / W, offset l % W, WIDTH apart
-  auto lane_input = [&](int l) { return &lane_in[(l / W) * ML::N_INPUT * W + l % W]; };
-  auto lane_output = [&](int l) { return &lane_out[(l / W) * ML::N_OUTPUT * W + l % W]; };
+  auto lane_input = [&](int l) { return ML::lane_input(lane_in.data(), l); };
+  auto lane_output = [&](int l) { return ML::lane_output(lane_out.data(), l); };
 
   const AtomRows v(atom->v), omega(atom->omega), f(atom->f), torque(atom->torque);
   const double *radius = atom->radius, *rmass = atom->rmass;
@@ -509,7 +396,7 @@ void PairGranularOpt::compute_fused_contacts()
   auto pack_model = [&](const Contact &c, double *in, int stride) {
     const PairScales &ps = pair_scales[c.scales];
     ML::pack_contact_model(in, stride, fused[c.model], model_dt[c.model], radius[c.i],
-                           radius[c.j], ps.reff, ps.scales);
+                           radius[c.j], ps.reff, ps.scales, ML::LEVER_SHIFT_PAIR);
   };
   auto pack_contact = [&](const Contact &c, double s, double *in, int stride) {
     pack_state(c, s, in, stride);
@@ -591,13 +478,8 @@ void PairGranularOpt::compute_fused_contacts()
         pack_contact(c, jkr_root[next_root++], lane_input(nlanes), W);
       nlanes++;
     }
-    // a short last block: its other lanes evaluate copies of its first contact, not unpacked
-    const int nblocks = (nlanes + W - 1) / W;
-    for (int l = nlanes; l < nblocks * W; l++) {
-      const double *first = lane_input(l - l % W);
-      double *pad = lane_input(l);
-      for (int q = 0; q < ML::N_INPUT; q++) pad[q * W] = first[q * W];
-    }
+    // a short last block: its other lanes evaluate copies of its first contact, not scattered
+    const std::size_t nblocks = ML::pad_last_block(lane_in.data(), nlanes);
     ML::contacts_in_lanes(nblocks, lane_in.data(), lane_out.data(), history_update);
 
     for (std::size_t k = 0; k < m; k++) {

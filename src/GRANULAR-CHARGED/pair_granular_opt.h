@@ -16,6 +16,7 @@ PairStyle(granular/opt,PairGranularOpt);
 #ifndef LMP_PAIR_GRANULAR_OPT_H
 #define LMP_PAIR_GRANULAR_OPT_H
 
+#include "granular_history_handover.h"
 #include "marshall_fused_set.h"
 #include "marshall_kernels.h"
 #include "pair_granular.h"
@@ -82,6 +83,8 @@ class PairGranularOpt : public PairGranular {
   std::vector<double> lane_in, lane_out;
   std::vector<int> lane_of;
   std::vector<double> model_dt;          // time step of each model
+  // the contact history across restarts and switches of style
+  GranularHistoryHandover history_handover;
   // the pairs outside the fused set (atom, index in its list) and their list for
   // PairGranular::compute, with copies of their contact flags and histories
   std::vector<int> generic_i, generic_jj;
@@ -92,16 +95,12 @@ class PairGranularOpt : public PairGranular {
   std::vector<double *> generic_firsthistory;
 
   void setup_fused();
-  // the contact history across a switch of style: see the .cpp
-  bool history_fresh;                    // its fix was created empty by this style's first init
-  bool history_fresh_checked;            // the touching pairs of a fresh history were counted
-  void adopt_restart_history();
-  void warn_fresh_history();
   // the steps of compute()
   void begin_step(int eflag, int vflag);
   void type_scales();
   void gather_contacts();
   bigint compute_generic_pairs(int eflag, int vflag);
+  void build_generic_list();
   void compute_fused_contacts();
   int scales_of(int i, int j, const FusedMarshall &fm);
 };

@@ -70,8 +70,11 @@ void direction(std::mt19937_64 &rng, double *n)
 std::vector<double> random_contact(std::mt19937_64 &rng, int c)
 {
   std::vector<double> in(ML::N_INPUT, 0.0);
-  const double radi = uniform(rng, 1.0e-6, 3.0e-6), radj = uniform(rng, 1.0e-6, 3.0e-6);
-  const double reff = MK::effective_radius(radi, radj);
+  // a contact with a wall (fix wall/gran/opt) is one with a fixed partner of radius 0 at rest
+  const bool wall = c % 29 == 7;
+  const double radi = uniform(rng, 1.0e-6, 3.0e-6), radj_drawn = uniform(rng, 1.0e-6, 3.0e-6);
+  const double radj = wall ? 0.0 : radj_drawn;
+  const double reff = wall ? radi : MK::effective_radius(radi, radj);
   const double gamma = (c % 2) ? 0.01 : 0.05, emix = (c % 3) ? 1.1e8 : 3.0e8;
   const MK::JKRScales sc = MK::jkr_scales(reff, gamma, emix);
   // overlap: tension down to exactly -delta_C, around zero, loading to a few delta_C
@@ -93,6 +96,7 @@ std::vector<double> random_contact(std::mt19937_64 &rng, int c)
     in[ML::VR + k] = vscale * uniform(rng, -1.0, 1.0);
     in[ML::OMEGA_I + k] = wscale * uniform(rng, -1.0, 1.0);
     in[ML::OMEGA_J + k] = wscale * uniform(rng, -1.0, 1.0);
+    if (wall) in[ML::OMEGA_J + k] = 0.0;
   }
   in[ML::RAD_I] = radi;
   in[ML::RAD_J] = radj;
@@ -106,6 +110,8 @@ std::vector<double> random_contact(std::mt19937_64 &rng, int c)
   in[ML::MASS_I] = mass * radi * radi * radi;
   in[ML::MASS_J] = mass * radj * radj * radj;
   in[ML::FIXED] = (c % 13 == 1) ? ML::FIXED_I : (c % 13 == 2) ? ML::FIXED_J : ML::FIXED_NONE;
+  if (wall) in[ML::FIXED] = ML::FIXED_J;
+  in[ML::LEVER_SHIFT] = wall ? ML::LEVER_SHIFT_WALL : ML::LEVER_SHIFT_PAIR;
   in[ML::ALPHA] = MK::damping_alpha(uniform(rng, 0.1, 0.9));
   in[ML::K_T] = 8.0 * emix / 2.6;
   in[ML::MU] = uniform(rng, 0.1, 0.5);
@@ -190,6 +196,44 @@ TEST(MarshallLanes, SameBitsAsScalarOnEveryPath)
     expect_same_as_scalar(path, true);
     expect_same_as_scalar(path, false);
   }
+}
+
+// The torque's lever arm (GranularModel::calculate_forces, dist_to_contact): R - delta / 2 on
+// each particle of a pair, R at a wall. Without rolling and twisting both torques are the
+// sliding torque t = -(n x F_t) times a lever arm, so torque_i (R_j - delta / 2) and
+// torque_j (R_i - delta / 2) are t times the same two factors, and the same contact packed as a
+// wall contact has torque_i R_i / (R_i - delta / 2) of the pair's. Tolerance 1e-14 relative:
+// each side is t rounded by two multiplications (a few units of 2.2e-16); a wrong lever arm is
+// off by delta / (2 R), here ~1e-3.
+TEST(MarshallLanes, LeverArmOfPairAndWall)
+{
+  std::mt19937_64 rng(20261206);
+  int checked = 0;
+  for (int c = 0; c < 200; c++) {
+    std::vector<double> in = random_contact(rng, c);
+    if (in[ML::RAD_J] == 0.0) continue;    // a wall contact of the set
+    in[ML::ROLLING] = in[ML::TWISTING] = 0.0;
+    const double *dx = &in[ML::DX];
+    const double delta = in[ML::RAD_I] + in[ML::RAD_J] -
+        std::sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
+    const double lever_i = in[ML::RAD_I] - 0.5 * delta, lever_j = in[ML::RAD_J] - 0.5 * delta;
+    double pair[ML::N_OUTPUT], wall[ML::N_OUTPUT];
+    ML::marshall_contact(in.data(), pair, true);
+    in[ML::LEVER_SHIFT] = ML::LEVER_SHIFT_WALL;
+    ML::marshall_contact(in.data(), wall, true);
+    for (int k = 0; k < 3; k++) {
+      const double ti = pair[ML::TORQUE_I + k], tj = pair[ML::TORQUE_J + k];
+      if (ti == 0.0) continue;
+      EXPECT_NEAR(ti * lever_j, tj * lever_i, 1e-14 * std::fabs(ti * lever_j))
+          << "pair, contact " << c;
+      EXPECT_NEAR(wall[ML::TORQUE_I + k] * lever_i, ti * in[ML::RAD_I],
+                  1e-14 * std::fabs(ti * in[ML::RAD_I]))
+          << "wall, contact " << c;
+      EXPECT_EQ(wall[ML::FORCE + k], pair[ML::FORCE + k]) << "the lever arm moves no force";
+      checked++;
+    }
+  }
+  EXPECT_GT(checked, 300);
 }
 
 // the contacts cover the decisions they are meant to: counted with the scalar kernel's inputs
