@@ -317,7 +317,7 @@ namespace MarshallLanes {
   // contact). HERTZ must be 0: a contact without adhesion takes the scalar instantiation.
   void contacts_in_lanes(std::size_t nblocks, const double *in, double *out, bool history_update,
                          gcsimd::SimdPath path);
-  // the same on the default path (gcsimd::default_simd_path(), capped by GCFMM_SIMD)
+  // the same on the default path (gcsimd::default_simd_path(), capped by GCSIMD_MAX_PATH)
   void contacts_in_lanes(std::size_t nblocks, const double *in, double *out, bool history_update);
 
   // contact l's first input and output in such blocks: its input q at [q * WIDTH]
