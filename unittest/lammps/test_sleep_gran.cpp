@@ -296,11 +296,12 @@ TEST(FixSleepGran, CoulombSleepersAreAStaticSource)
     const auto f = gather(l, "f", 3);
     // the sleepers' forces are zero in both (fix sleep/gran). The awake atoms' forces must meet
     // the requested accuracy (the split: Solver over the awake charges + the static field of the
-    // sleeping ones; the reference's own error is 1e-9). Measured ~1e-11: in this sparse set the
-    // nearest pairs, summed directly, dominate every force, so the test guards the split's
+    // sleeping ones; the reference's own error is 1e-9). Measured ~1e-11: the contact forces of
+    // the pair style dominate f, so the test guards the split's
     // bookkeeping (the sleepers' field at the right atoms: 0.96 when it was not, 0.96 without
-    // the static field); its accuracy with multipole translations is fmm.static_field's
-    // (SplitPlusStaticEqualsWholeSolver) and the deposition's check (doc/fix_coul_fmm.rst)
+    // the static field); the Coulomb forces alone are checked by
+    // CoulombStaticSleepersMeetTheRequestAtTheAwakeAtoms, the split with multipole translations by
+    // fmm.static_field (SplitPlusStaticEqualsWholeSolver)
     const double err = rel_rms(f, fref);
     std::printf("[ static sleepers, %s ] accuracy %g: force error %.3g, energy error %.3g\n", solver,
                 acc, err, std::abs(l.var("f_coul") / eref - 1.0));
