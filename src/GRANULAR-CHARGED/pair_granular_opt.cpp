@@ -40,8 +40,8 @@ namespace ML = MarshallLanes;
 
 PairGranularOpt::PairGranularOpt(LAMMPS *lmp) :
     PairGranular(lmp), fused_ready(false), generic_only(true), any_heat(false), ncontacts(0),
-    history_update(true), hist_tangential(0), hist_rolling(0), hist_twisting(0),
-    history_handover(lmp)
+    history_update(true), hist_tangential(0), hist_rolling(0), hist_twisting(0), one_pair(false),
+    list_stale(true), list_rebuilds(0), history_handover(lmp)
 {
 }
 
@@ -72,6 +72,7 @@ void PairGranularOpt::init_style()
   PairGranular::init_style();
   if (first_init) history_handover.history_created(fix_history);
   fused_ready = false;    // init_one() may still mix new models: set up before the first compute
+  list_stale = true;      // models, groups or special factors may have changed
   FixChargeCheck::ensure(lmp);    // charges without a Coulomb solver: warned at init
 }
 
@@ -131,17 +132,16 @@ void PairGranularOpt::compute(int eflag, int vflag)
     return;
   }
   begin_step(eflag, vflag);
-  gather_contacts();
-  history_handover.check_fresh_history(static_cast<bigint>(contacts.size()));
+  if (!contact_list_current()) build_contact_list();
+  // the pairs outside the fused set first: their forces are summed before the fused contacts'
   const bigint generic_contacts = generic_i.empty() ? 0 : compute_generic_pairs(eflag, vflag);
-  jkr_root.resize(jkr_overlap.size());
-  JKRScaled::roots(jkr_overlap.size(), jkr_overlap.data(), jkr_root.data());
-  compute_fused_contacts();
-  ncontacts = static_cast<bigint>(contacts.size()) + generic_contacts;
+  const bigint fused_contacts = compute_fused_contacts();
+  history_handover.check_fresh_history(fused_contacts);
+  ncontacts = fused_contacts + generic_contacts;
 }
 
 /* ----------------------------------------------------------------------
-   set-up of one compute(): history updates, tallies, the JKR scales of each type pair when every atom of a type has the same radius
+   set-up of one compute(): history updates, tallies
 ------------------------------------------------------------------------- */
 
 void PairGranularOpt::begin_step(int eflag, int vflag)
@@ -149,7 +149,33 @@ void PairGranularOpt::begin_step(int eflag, int vflag)
   history_update = update->setupflag == 0;
   for (int n = 0; n < nmodels; n++) models_list[n]->history_update = history_update;
   ev_init(eflag, vflag);
-  type_scales();
+}
+
+/* ----------------------------------------------------------------------
+   is the contact list the one of this neighbor list, with the radii and types it was built
+   from? A build of the neighbor list (neighbor->ago == 0, or another build count or list),
+   another number of atoms, init_style() or any atom's new radius (fix adapt, set) or type
+   makes it stale.
+------------------------------------------------------------------------- */
+
+bool PairGranularOpt::contact_list_current()
+{
+  const int nall = atom->nlocal + atom->nghost;
+  ListStamp now;
+  now.list = list;
+  now.ilist = list->ilist;
+  now.firstneigh = list->firstneigh;
+  now.firstflag = fix_history->firstflag;
+  now.firstvalue = fix_history->firstvalue;
+  now.build = neighbor->ncalls;
+  now.build_step = neighbor->lastcall;
+  now.inum = list->inum;
+  now.nall = nall;
+  const bool current = !list_stale && neighbor->ago != 0 && now == list_stamp &&
+      std::equal(atom->radius, atom->radius + nall, list_radius.begin()) &&
+      std::equal(atom->type, atom->type + nall, list_type.begin());
+  list_stamp = now;
+  return current;
 }
 
 /* ----------------------------------------------------------------------
@@ -188,7 +214,8 @@ void PairGranularOpt::type_scales()
 
 /* ----------------------------------------------------------------------
    the entry of pair_scales with R_eff and the JKR scales of pair i, j of a fused model: its
-   type pair's if valid, else one appended for this pair (type_scales() drops those each step)
+   type pair's if valid, else one appended for this pair (type_scales() drops those at each
+   rebuild of the contact list)
 ------------------------------------------------------------------------- */
 
 inline int PairGranularOpt::scales_of(int i, int j, const FusedMarshall &fm)
@@ -203,75 +230,62 @@ inline int PairGranularOpt::scales_of(int i, int j, const FusedMarshall &fm)
 }
 
 /* ----------------------------------------------------------------------
-   the pairs that interact, in list order: a fused pair's contact life decided (touch and
-   history of an ended contact reset), its R_eff and scales and (adhesive) scaled overlap kept;
-   a pair of another model copied with its contact flag and history to the generic list
+   the contact list from the neighbor list, in list order: each pair of a fused model (with
+   its R_eff and scales, special factor, contact flag and history in fix neigh/history's pages),
+   and the pairs of other models for the generic list; the radii and types it was built from
 ------------------------------------------------------------------------- */
 
-void PairGranularOpt::gather_contacts()
+void PairGranularOpt::build_contact_list()
 {
-  int *type = atom->type;
-  const AtomRows x(atom->x);
-  double *radius = atom->radius;
-  double *special_lj = force->special_lj;
+  const int nall = atom->nlocal + atom->nghost;
+  const int *type = atom->type;
+  const double *radius = atom->radius;
+  const double *special_lj = force->special_lj;
   const int size_hist = get_size_history();
-  const int inum = list->inum;
-  contacts.clear();
-  jkr_overlap.clear();
+  type_scales();
+  candidates.clear();
   generic_i.clear();
   generic_jj.clear();
-  for (int ii = 0; ii < inum; ii++) {
+  for (int ii = 0; ii < list->inum; ii++) {
     const int i = list->ilist[ii];
-    int *touch = use_history ? fix_history->firstflag[i] : nullptr;
-    double *allhistory = use_history ? fix_history->firstvalue[i] : nullptr;
+    int *touch = fix_history->firstflag[i];
+    double *allhistory = fix_history->firstvalue[i];
     const int *jlist = list->firstneigh[i];
     const int jnum = list->numneigh[i];
-    // i's data held in registers over its neighbors (the stores to touch flags, histories and
-    // contacts would otherwise make the compiler read them again for each)
-    const double xi[3] = {x[i][0], x[i][1], x[i][2]};
-    const double radi = radius[i];
-    const int *models_of_i = types_indices[type[i]];
-    const FusedMarshall *fused_models = fused.data();
     for (int jj = 0; jj < jnum; jj++) {
       const int j = jlist[jj] & NEIGHMASK;
       const double factor_lj = special_lj[sbmask(jlist[jj])];
       if (factor_lj == 0) continue;
-      const int model = models_of_i[type[j]];
-      const FusedMarshall &fm = fused_models[model];
+      const int model = types_indices[type[i]][type[j]];
+      const FusedMarshall &fm = fused[model];
       if (!fm.on) {
         generic_i.push_back(i);
         generic_jj.push_back(jj);
         continue;
       }
-      double dx[3];
-      sub3(xi, x[j], dx);
-      const double rsq = lensq3(dx);
-      const double radsum = radi + radius[j];
-      // most neighbors of a deposition do not touch: reject those before R_eff and the scales
-      // (their history is zero already: zeroed when the contact ended, or new from the list)
-      if (!touch[jj] && rsq >= radsum * radsum) continue;
-      const int scales = scales_of(i, j, fm);
-      const MK::JKRScales &sc = pair_scales[scales].scales;
-      if (!MK::jkr_touch(touch[jj] != 0, rsq, radsum, sc.deltac)) {
-        touch[jj] = 0;
-        double *history = &allhistory[size_hist * jj];
-        for (int k = 0; k < size_hist; k++) history[k] = 0.0;
-        continue;
-      }
-      touch[jj] = 1;
-      if (fm.gamma != 0.0) jkr_overlap.push_back(MK::scaled_overlap(sc, radsum - sqrt(rsq)));
       // written field by field: a whole struct built on the stack and copied stalls the
       // store-to-load forwarding of its parts
-      Contact &c = contacts.emplace_back();
+      Candidate &c = candidates.emplace_back();
       c.i = i;
-      c.jj = jj;
       c.j = j;
       c.model = model;
-      c.scales = scales;
+      c.scales = scales_of(i, j, fm);
+      c.radsum = radius[i] + radius[j];
       c.factor_lj = factor_lj;
-      copy3(dx, c.dx);
+      c.touch = &touch[jj];
+      c.history = &allhistory[size_hist * jj];
     }
   }
+  // every candidate of one model and one type pair whose atoms have one radius each (a
+  // monodisperse packing of one type): the shared inputs are written into every lane once
+  one_pair = !candidates.empty() && pair_scales[candidates[0].scales].valid;
+  for (std::size_t k = 0; k < candidates.size() && one_pair; k++)
+    one_pair = candidates[k].model == candidates[0].model &&
+        candidates[k].scales == candidates[0].scales;
+  list_radius.assign(radius, radius + nall);
+  list_type.assign(type, type + nall);
+  list_stale = false;
+  list_rebuilds++;
 }
 
 /* ----------------------------------------------------------------------
@@ -352,55 +366,54 @@ void PairGranularOpt::build_generic_list()
 
 /* ----------------------------------------------------------------------
    the fused contacts in list order, a chunk at a time (its lanes blocks stay in the L1
-   cache): the adhesive contacts packed into lanes blocks and evaluated by the lanes kernel
-   (marshall_lanes.h) on the default SIMD path, the others (no adhesion: Hertz's law) by the
-   scalar instantiation of the same kernel; then each contact's results unpacked and summed in
-   list order, so the sums over contacts are those of a scalar loop
+   cache): each candidate's contact life decided (touch flag set, or reset with its history
+   when the contact ended), the touching adhesive ones packed into lanes blocks, their JKR roots
+   solved together and evaluated by the lanes kernel (marshall_lanes.h) on the default SIMD
+   path, the others (no adhesion: Hertz's law) by the scalar instantiation of the same kernel;
+   then each contact's results unpacked and summed in list order, so the sums over contacts are
+   those of a scalar loop. Returns the number of touching contacts.
 ------------------------------------------------------------------------- */
 
-void PairGranularOpt::compute_fused_contacts()
+bigint PairGranularOpt::compute_fused_contacts()
 {
   constexpr int W = ML::WIDTH;
   constexpr std::size_t CHUNK = 8 * W;
   constexpr std::size_t PREFETCH = 4;
-  const std::size_t n = contacts.size();
+  const std::size_t ncand = candidates.size();
   lane_in.resize(CHUNK * ML::N_INPUT);
   lane_out.resize(CHUNK * ML::N_OUTPUT);
-  lane_of.resize(CHUNK);
+  chunk.resize(CHUNK);
+  jkr_overlap.resize(CHUNK);
+  jkr_root.resize(CHUNK);
   // lane l's first input and output: block l / W, offset l % W, WIDTH apart
   auto lane_input = [&](int l) { return ML::lane_input(lane_in.data(), l); };
   auto lane_output = [&](int l) { return ML::lane_output(lane_out.data(), l); };
 
-  const AtomRows v(atom->v), omega(atom->omega), f(atom->f), torque(atom->torque);
+  const AtomRows x(atom->x), v(atom->v), omega(atom->omega), f(atom->f), torque(atom->torque);
   const double *radius = atom->radius, *rmass = atom->rmass;
   const int *mask = atom->mask;
   const int nlocal = atom->nlocal;
   const int newton_pair = force->newton_pair;
-  double **allhistory = fix_history->firstvalue;
   const int size_hist = get_size_history();
   // a contact's inputs (marshall_lanes.h) in two parts: those of its atoms and history (s: its
   // JKR root, unused without adhesion) and those of its model and type pair, the same for every
   // contact of one type pair of one radius each
-  auto pack_state = [&](const Contact &c, double s, double *in, int stride) {
+  auto pack_state = [&](const Candidate &c, const double *dx, double s, double *in, int stride) {
     const int i = c.i, j = c.j;
     const FusedMarshall &fm = fused[c.model];
-    const double *history = &allhistory[i][size_hist * c.jj];
+    const double *history = c.history;
     double fixed = ML::FIXED_NONE;
     if (mask[i] & freeze_group_bit) fixed = ML::FIXED_I;
     if (mask[j] & freeze_group_bit) fixed = ML::FIXED_J;
-    ML::pack_contact_state(in, stride, c.dx, v[i], v[j], omega[i], omega[j],
+    ML::pack_contact_state(in, stride, dx, v[i], v[j], omega[i], omega[j],
                            history + hist_tangential, fm.rolling ? history + hist_rolling : nullptr,
                            fm.twisting ? history + hist_twisting : nullptr, s, rmass[i], rmass[j],
                            fixed);
   };
-  auto pack_model = [&](const Contact &c, double *in, int stride) {
+  auto pack_model = [&](const Candidate &c, double *in, int stride) {
     const PairScales &ps = pair_scales[c.scales];
     ML::pack_contact_model(in, stride, fused[c.model], model_dt[c.model], radius[c.i],
                            radius[c.j], ps.reff, ps.scales, ML::LEVER_SHIFT_PAIR);
-  };
-  auto pack_contact = [&](const Contact &c, double s, double *in, int stride) {
-    pack_state(c, s, in, stride);
-    pack_model(c, in, stride);
   };
   // the force and torque on atom i summed in registers over its consecutive contacts (those of
   // one entry of the neighbor list, none of which has i as its neighbor j): f[i] and torque[i]
@@ -416,10 +429,10 @@ void PairGranularOpt::compute_fused_contacts()
   };
   // a contact's results: its histories (the sub-models it has), forces and torques times
   // factor_lj to the atoms, the tallies
-  auto unpack_contact = [&](const Contact &c, const double *out, int stride) {
+  auto unpack_contact = [&](const Candidate &c, const double *dx, const double *out, int stride) {
     const int i = c.i, j = c.j;
     const FusedMarshall &fm = fused[c.model];
-    double *history = &allhistory[i][size_hist * c.jj];
+    double *history = c.history;
     ML::unpack_histories(out, stride, history + hist_tangential,
                          fm.rolling ? history + hist_rolling : nullptr,
                          fm.twisting ? history + hist_twisting : nullptr);
@@ -441,63 +454,83 @@ void PairGranularOpt::compute_fused_contacts()
         torque[j][k] = torque[j][k] + torque_j[k];
       }
     if (evflag)
-      ev_tally_xyz(i, j, nlocal, newton_pair, 0.0, 0.0, forces[0], forces[1], forces[2], c.dx[0],
-                   c.dx[1], c.dx[2]);
+      ev_tally_xyz(i, j, nlocal, newton_pair, 0.0, 0.0, forces[0], forces[1], forces[2], dx[0],
+                   dx[1], dx[2]);
   };
 
   model_dt.resize(nmodels);
   for (int m = 0; m < nmodels; m++) model_dt[m] = models_list[m]->dt;
-  // every contact of one model and one type pair whose atoms have one radius each (a
-  // monodisperse packing of one type): the shared inputs are written into every lane once
-  bool one_pair = n > 0 && pair_scales[contacts[0].scales].valid;
-  for (std::size_t k = 0; k < n && one_pair; k++)
-    one_pair = contacts[k].model == contacts[0].model && contacts[k].scales == contacts[0].scales;
   if (one_pair)
-    for (int l = 0; l < static_cast<int>(CHUNK); l++) pack_model(contacts[0], lane_input(l), W);
-  std::size_t next_root = 0;
-  for (std::size_t start = 0; start < n; start += CHUNK) {
-    const std::size_t m = std::min(CHUNK, n - start);
+    for (int l = 0; l < static_cast<int>(CHUNK); l++) pack_model(candidates[0], lane_input(l), W);
+  bigint touching = 0;
+  std::size_t next = 0;    // the next candidate to decide
+  while (next < ncand) {
+    // up to CHUNK touching contacts: life decided, adhesive ones packed (root still to come)
+    std::size_t m = 0;
     int nlanes = 0;
-    for (std::size_t k = 0; k < m; k++) {
-      const Contact &c = contacts[start + k];
-      // the neighbor's data a few contacts ahead: each contact's loads then overlap with the
-      // packing of the previous ones
-      if (start + k + PREFETCH < n) {
-        const int jn = contacts[start + k + PREFETCH].j;
+    for (; next < ncand && m < CHUNK; next++) {
+      // the data of a candidate a few ahead: its loads overlap with this one's work
+      if (next + PREFETCH < ncand) {
+        const int jn = candidates[next + PREFETCH].j;
+        __builtin_prefetch(x[jn]);
         __builtin_prefetch(v[jn]);
         __builtin_prefetch(omega[jn]);
       }
-      if (fused[c.model].gamma == 0.0) {
-        lane_of[k] = -1;
+      const Candidate &c = candidates[next];
+      double dx[3];
+      sub3(x[c.i], x[c.j], dx);
+      const double rsq = lensq3(dx);
+      const double radsum = c.radsum;
+      // most neighbors of a deposition do not touch: reject those before the scales
+      // (their history is zero already: zeroed when the contact ended, or new from the list)
+      const bool was_touching = *c.touch != 0;
+      if (!was_touching && rsq >= radsum * radsum) continue;
+      const MK::JKRScales &sc = pair_scales[c.scales].scales;
+      if (!MK::jkr_touch(was_touching, rsq, radsum, sc.deltac)) {
+        *c.touch = 0;
+        for (int k = 0; k < size_hist; k++) c.history[k] = 0.0;
         continue;
       }
-      lane_of[k] = nlanes;
-      if (one_pair)
-        pack_state(c, jkr_root[next_root++], lane_input(nlanes), W);
-      else
-        pack_contact(c, jkr_root[next_root++], lane_input(nlanes), W);
+      *c.touch = 1;
+      ChunkContact &cc = chunk[m++];
+      cc.candidate = static_cast<int>(next);
+      copy3(dx, cc.dx);
+      if (fused[c.model].gamma == 0.0) {
+        cc.lane = -1;
+        continue;
+      }
+      cc.lane = nlanes;
+      jkr_overlap[nlanes] = MK::scaled_overlap(sc, radsum - sqrt(rsq));
+      pack_state(c, dx, 0.0, lane_input(nlanes), W);
+      if (!one_pair) pack_model(c, lane_input(nlanes), W);
       nlanes++;
     }
+    touching += static_cast<bigint>(m);
+    JKRScaled::roots(nlanes, jkr_overlap.data(), jkr_root.data());
+    for (int l = 0; l < nlanes; l++) lane_input(l)[ML::ROOT * W] = jkr_root[l];
     // a short last block: its other lanes evaluate copies of its first contact, not scattered
     const std::size_t nblocks = ML::pad_last_block(lane_in.data(), nlanes);
     ML::contacts_in_lanes(nblocks, lane_in.data(), lane_out.data(), history_update);
 
     for (std::size_t k = 0; k < m; k++) {
-      const Contact &c = contacts[start + k];
+      const ChunkContact &cc = chunk[k];
+      const Candidate &c = candidates[cc.candidate];
       if (k + PREFETCH < m) {
-        const int jn = contacts[start + k + PREFETCH].j;
+        const int jn = candidates[chunk[k + PREFETCH].candidate].j;
         __builtin_prefetch(f[jn], 1);
         __builtin_prefetch(torque[jn], 1);
       }
-      if (lane_of[k] >= 0) {
-        unpack_contact(c, lane_output(lane_of[k]), W);
+      if (cc.lane >= 0) {
+        unpack_contact(c, cc.dx, lane_output(cc.lane), W);
       } else {
         double in[ML::N_INPUT], out[ML::N_OUTPUT];
-        pack_contact(c, 1.0, in, 1);
+        pack_state(c, cc.dx, 1.0, in, 1);
+        pack_model(c, in, 1);
         ML::marshall_contact(in, out, history_update);
-        unpack_contact(c, out, 1);
+        unpack_contact(c, cc.dx, out, 1);
       }
     }
   }
   store_sums();
+  return touching;
 }

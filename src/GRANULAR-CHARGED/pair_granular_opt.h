@@ -45,6 +45,8 @@ class PairGranularOpt : public PairGranular {
 
   // contacts (touching pairs) whose forces the last compute() evaluated in its own loop
   bigint contacts_computed() const { return ncontacts; }
+  // times the persistent contact list was built (tests: it follows the neighbor list)
+  bigint contact_list_rebuilds() const { return list_rebuilds; }
 
  protected:
   // coefficients of one model for the fused kernel, copied from its sub-models
@@ -66,22 +68,52 @@ class PairGranularOpt : public PairGranular {
     MarshallKernels::JKRScales scales;
   };
   std::vector<double> type_radius;       // radius of every atom of a type (-1: none)
-  // per type pair (itype * (ntypes + 1) + jtype), then those of the fused contacts of this
-  // compute() whose type pair has none (atoms of one type with several radii)
+  // per type pair (itype * (ntypes + 1) + jtype), then those of the candidates whose type pair
+  // has none (atoms of one type with several radii)
   std::vector<PairScales> pair_scales;
-  // one fused contact of this compute(): atom, index in its neighbor list, the neighbor, its
-  // model, the entry of pair_scales, special factor and x_i - x_j
-  struct Contact {
-    int i, jj, j, model, scales;
-    double factor_lj;
+
+  // The contact list, persistent between neighbor-list builds: every pair of the list that the
+  // fused kernel computes (a candidate: touching or not), in list order, which is the order of
+  // the lanes and of the sums over contacts. What a pair keeps between builds is fixed until the
+  // next: atoms, model, R_eff and scales (from radius and type, checked each step), special
+  // factor and where its contact flag and history are in fix neigh/history's pages (laid anew
+  // by each build). Each step reads only positions, velocities, spins, masses, flags and
+  // histories; rebuilt with the list, after init_style() and when radius or type changed.
+  struct Candidate {
+    int i, j, model, scales;
+    double radsum, factor_lj;
+    int *touch;
+    double *history;
+  };
+  std::vector<Candidate> candidates;
+  bool one_pair;                         // every candidate of one model and one valid type pair
+  // what the contact list was built from: a change of any of these rebuilds it
+  struct ListStamp {
+    const void *list = nullptr, *ilist = nullptr, *firstneigh = nullptr, *firstflag = nullptr,
+               *firstvalue = nullptr;
+    bigint build = -1, build_step = -1;
+    int inum = -1, nall = -1;
+    bool operator==(const ListStamp &o) const
+    {
+      return list == o.list && ilist == o.ilist && firstneigh == o.firstneigh &&
+          firstflag == o.firstflag && firstvalue == o.firstvalue && build == o.build &&
+          build_step == o.build_step && inum == o.inum && nall == o.nall;
+    }
+  };
+  ListStamp list_stamp;
+  bool list_stale;                       // set by init_style(): rebuild at the next compute()
+  std::vector<double> list_radius;       // radius and type of every atom at the last rebuild
+  std::vector<int> list_type;
+  bigint list_rebuilds;                  // contact-list rebuilds so far (tests)
+  // one chunk's touching contacts: candidate, lane (-1: the scalar kernel), x_i - x_j
+  struct ChunkContact {
+    int candidate, lane;
     double dx[3];
   };
-  std::vector<Contact> contacts;
-  std::vector<double> jkr_overlap, jkr_root;    // the adhesive contacts' scaled overlaps, roots
-  // lanes blocks of one chunk of contacts (marshall_lanes.h) and each contact's lane (-1: the
-  // scalar kernel)
+  std::vector<ChunkContact> chunk;
+  std::vector<double> jkr_overlap, jkr_root;    // a chunk's scaled overlaps and JKR roots
+  // lanes blocks of one chunk of contacts (marshall_lanes.h)
   std::vector<double> lane_in, lane_out;
-  std::vector<int> lane_of;
   std::vector<double> model_dt;          // time step of each model
   // the contact history across restarts and switches of style
   GranularHistoryHandover history_handover;
@@ -97,11 +129,12 @@ class PairGranularOpt : public PairGranular {
   void setup_fused();
   // the steps of compute()
   void begin_step(int eflag, int vflag);
+  bool contact_list_current();
+  void build_contact_list();
   void type_scales();
-  void gather_contacts();
   bigint compute_generic_pairs(int eflag, int vflag);
   void build_generic_list();
-  void compute_fused_contacts();
+  bigint compute_fused_contacts();
   int scales_of(int i, int j, const FusedMarshall &fm);
 };
 

@@ -38,3 +38,6 @@ target_compile_options(test_marshall_lanes PRIVATE ${GCSIMD_BITWISE_OPTIONS} -Wn
 target_compile_definitions(test_marshall_lanes PRIVATE GC_LMP_EXECUTABLE="$<TARGET_FILE:lmp>"
                            GC_SOURCE_DIR="${CMAKE_SOURCE_DIR}")
 add_dependencies(test_marshall_lanes lmp)
+# granular/opt's contact list kept between neighbor-list builds against granular: contacts made
+# and broken between builds, radii changed by fix adapt and by set between runs
+gc_lammps_test(test_granular_opt_contact_list NP 1 2 SOURCES test_granular_opt_contact_list.cpp)
