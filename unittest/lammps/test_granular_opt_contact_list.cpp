@@ -6,8 +6,10 @@
    - radii changed between builds (fix adapt of the diameter every step);
    - radii and types changed by set between runs without a new set-up (run pre no).
    Tolerance as in test_granular_opt.cpp (1e-12 of each quantity's scale; bit for bit in
-   practice). A list that is not rebuilt when it should be computes the pairs of the previous
-   build with its radii and types and fails each of these. */
+   practice). Checked by breaking the list's rebuild: a list kept from the set-up on fails
+   ContactsMadeAndBrokenBetweenBuilds on the forces (from step 70) besides the rebuild count;
+   radii not compared fail RadiiChangedBetweenBuilds and SetBetweenRunsWithoutSetup, types not
+   compared SetBetweenRunsWithoutSetup. */
 #include "gc_testing.h"
 
 #include "force.h"
@@ -33,19 +35,20 @@ constexpr int EVERY = 10;    // neighbor-list builds every EVERY steps
 const char *MARSHALL = "jkr/marshall 2e8 0.7 0.33 0.01 damping marshall tangential marshall "
                        "0.3 rolling marshall 0.01 twisting marshall/jkr";
 
-// 27 spheres on a lattice with gaps, given velocities towards each other and spins: contacts
-// form on impact, load, slip and break as the cluster rebounds, many between two builds
+// 27 spheres on a lattice whose gaps exceed the neighbor skin (the first list holds no pair),
+// with random velocities of ~20 m/s and spins: pairs enter and leave the neighbor list from one
+// build to the next, contacts form on impact, load, slip and break, many between two builds
 std::vector<std::string> colliding(const std::string &pair_style, const std::string &newton,
                                    const std::string &atom_style = "sphere")
 {
   return {"units si", "atom_style " + atom_style, "atom_modify map array", "boundary p p p",
-          "newton " + newton, "comm_modify vel yes", "lattice sc 2.0e-6",
+          "newton " + newton, "comm_modify vel yes", "lattice sc 2.3e-6",
           "region box block 0 3 0 3 0 3", "create_box 2 box",
           "create_atoms 1 box", "set group all type/fraction 2 0.3 1234",
           "set group all diameter 1.999e-6", "set group all density 2500",
           "pair_style " + pair_style, std::string("pair_coeff * * ") + MARSHALL,
           "neighbor 2e-7 bin", "neigh_modify every " + std::to_string(EVERY) +
-          " delay 0 check no", "velocity all create 2e8 4928 loop geom",
+          " delay 0 check no", "velocity all create 3e11 4928 loop geom",
           "set group all omega 1e5 -2e5 3e5", "fix integrate all nve/sphere", "timestep 2e-10",
           "compute contacts all contact/atom", "compute nc all reduce sum c_contacts",
           "thermo 0"};
