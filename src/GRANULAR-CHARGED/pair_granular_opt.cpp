@@ -282,6 +282,7 @@ void PairGranularOpt::build_contact_list()
   for (std::size_t k = 0; k < candidates.size() && one_pair; k++)
     one_pair = candidates[k].model == candidates[0].model &&
         candidates[k].scales == candidates[0].scales;
+  lane_scales.assign(lane_scales.size(), -1);    // the entries of pair_scales are new
   list_radius.assign(radius, radius + nall);
   list_type.assign(type, type + nall);
   list_stale = false;
@@ -461,8 +462,12 @@ bigint PairGranularOpt::compute_fused_contacts()
                    dx[1], dx[2]);
   };
 
+  lane_scales.resize(CHUNK, -1);
   model_dt.resize(nmodels);
-  for (int m = 0; m < nmodels; m++) model_dt[m] = models_list[m]->dt;
+  for (int m = 0; m < nmodels; m++) {
+    if (model_dt[m] != models_list[m]->dt) lane_scales.assign(CHUNK, -1);
+    model_dt[m] = models_list[m]->dt;
+  }
   if (one_pair)
     for (int l = 0; l < static_cast<int>(CHUNK); l++) pack_model(candidates[0], lane_input(l), W);
   bigint touching = 0;
@@ -507,7 +512,10 @@ bigint PairGranularOpt::compute_fused_contacts()
       cc.lane = nlanes;
       jkr_overlap[nlanes] = MK::scaled_overlap(sc, radsum - sqrt(rsq));
       pack_state(c, dx, 0.0, lane_input(nlanes), W);
-      if (!one_pair) pack_model(c, lane_input(nlanes), W);
+      if (!one_pair && lane_scales[nlanes] != c.scales) {
+        pack_model(c, lane_input(nlanes), W);
+        lane_scales[nlanes] = c.scales;
+      }
       nlanes++;
     }
     touching += static_cast<bigint>(m);
@@ -515,6 +523,7 @@ bigint PairGranularOpt::compute_fused_contacts()
     for (int l = 0; l < nlanes; l++) lane_input(l)[ML::ROOT * W] = jkr_root[l];
     // a short last block: its other lanes evaluate copies of its first contact, not scattered
     const std::size_t nblocks = ML::pad_last_block(lane_in.data(), nlanes);
+    for (std::size_t l = nlanes; l < nblocks * W; l++) lane_scales[l] = lane_scales[l - l % W];
     ML::contacts_in_lanes(nblocks, lane_in.data(), lane_out.data(), history_update);
 
     for (std::size_t k = 0; k < m; k++) {

@@ -115,6 +115,10 @@ class PairGranularOpt : public PairGranular {
   // lanes blocks of one chunk of contacts (marshall_lanes.h)
   std::vector<double> lane_in, lane_out;
   std::vector<double> model_dt;          // time step of each model
+  // the entry of pair_scales whose model inputs each lane of the chunk holds (-1: none): kept
+  // from step to step, so a lane is written again only when its contact is of another model,
+  // type pair or pair of radii (cleared when the contact list or a time step changes)
+  std::vector<int> lane_scales;
   // the contact history across restarts and switches of style
   GranularHistoryHandover history_handover;
   // the pairs outside the fused set (atom, index in its list) and their list for

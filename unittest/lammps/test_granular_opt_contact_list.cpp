@@ -4,12 +4,14 @@
      contacts form and break between builds (checked from the contact count at steps without a
      build), and whose list follows the builds (one rebuild per build, none in between);
    - radii changed between builds (fix adapt of the diameter every step);
-   - radii and types changed by set between runs without a new set-up (run pre no).
+   - radii and types changed by set between runs without a new set-up (run pre no);
+   - the time step changed at every step (fix dt/reset).
    Tolerance as in test_granular_opt.cpp (1e-12 of each quantity's scale; bit for bit in
    practice). Checked by breaking the list's rebuild: a list kept from the set-up on fails
    ContactsMadeAndBrokenBetweenBuilds on the forces (from step 70) besides the rebuild count;
    radii not compared fail RadiiChangedBetweenBuilds and SetBetweenRunsWithoutSetup, types not
-   compared SetBetweenRunsWithoutSetup. */
+   compared SetBetweenRunsWithoutSetup, lanes kept across a change of time step
+   TimeStepChangedBetweenBuilds. */
 #include "gc_testing.h"
 
 #include "force.h"
@@ -200,6 +202,25 @@ TEST(GranularOptContactList, SetBetweenRunsWithoutSetup)
     record(l, tag);
     l.cmds({"run 105", "set atom 1*10 diameter 2.004e-6", "run 2 pre no",
             "set atom 11*13 type 2", "run 2 pre no"});
+    runs[k] = recorded(l, tag);
+    k++;
+  }
+  expect_same_forces(runs[0].forces, runs[1].forces);
+}
+
+// fix dt/reset changes the time step at every step, with no neighbor-list build: the lanes'
+// model inputs kept from the step before must follow it
+TEST(GranularOptContactList, TimeStepChangedBetweenBuilds)
+{
+  Recording runs[2];
+  int k = 0;
+  for (const std::string style : {"granular", "granular/opt"}) {
+    Lmp l;
+    l.cmds(colliding(style, "on"));
+    l.cmd("fix dtr all dt/reset 1 5e-11 4e-10 1e-8 units box");
+    const std::string tag = "dt" + std::to_string(k);
+    record(l, tag);
+    l.cmd("run 300");
     runs[k] = recorded(l, tag);
     k++;
   }
