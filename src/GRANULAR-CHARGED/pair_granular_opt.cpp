@@ -112,10 +112,11 @@ void PairGranularOpt::setup_fused()
 }
 
 /* ----------------------------------------------------------------------
-   PairGranular::compute() with the Marshall set fused, as a recipe: set-up, gather (the
-   contacts' life decided, the pairs outside the fused set handed to PairGranular::compute on a
-   list of their own), the JKR roots in one batch, each contact packed into SIMD lanes, the
-   fused kernel, each contact's results unpacked (marshall_lanes.h). The fused kernel does what
+   PairGranular::compute() with the Marshall set fused, as a recipe: set-up, the contact list
+   (kept between neighbor-list builds), the pairs outside the fused set handed to
+   PairGranular::compute on a list of their own, then a chunk of contacts at a time: their life
+   decided, each touching one packed into SIMD lanes, their JKR roots in one batch, the fused
+   kernel, each contact's results unpacked (marshall_lanes.h). The fused kernel does what
    GranularModel::check_contact() and calculate_forces() do with the Marshall sub-models, in the
    same order of operations, skipping what the set does not use (relative tangential speed,
    heat, classic torque scaling). The history of a pair is the same array at the same offsets,
@@ -180,8 +181,8 @@ bool PairGranularOpt::contact_list_current()
 
 /* ----------------------------------------------------------------------
    per type pair: R_eff and the JKR scales, valid when all atoms (local and ghost) of both
-   types have one radius each (a monodisperse packing: two cube roots per type pair and step
-   instead of per contact)
+   types have one radius each (a monodisperse packing: two cube roots per type pair and build
+   of the contact list instead of per pair)
 ------------------------------------------------------------------------- */
 
 void PairGranularOpt::type_scales()
