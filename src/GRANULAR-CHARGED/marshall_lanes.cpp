@@ -20,31 +20,62 @@ namespace {
 
 using namespace LAMMPS_NS::MarshallLanes;
 
-template <bool HISTORY_UPDATE>
+// a block as WIDTH / W vectors of W lanes: vectors wider than the path's registers would be
+// split into register pairs or quadruples by the compiler and spilled to the stack; the lanes
+// are independent, so every width gives the same bits
+template <int W, bool HISTORY_UPDATE>
 GCSIMD_ALWAYS_INLINE void lanes_blocks(std::size_t nblocks, const double *__restrict in,
                                        double *__restrict out)
 {
-  for (std::size_t b = 0; b < nblocks; ++b) {
-    // the block read and written in place, one vector per input and output
-    const auto *block_in = reinterpret_cast<const LanesInMemory *>(in + b * N_INPUT * WIDTH);
-    auto *block_out = reinterpret_cast<LanesInMemory *>(out + b * N_OUTPUT * WIDTH);
-    marshall_contact<LanesInMemory, Lanes>(block_in, block_out, HISTORY_UPDATE);
-  }
+  static_assert(WIDTH % W == 0, "a block holds whole vectors");
+  using Vector = typename LanesOf<W>::T;
+  using InMemory = typename LanesOf<W>::InMemory;
+  constexpr int PARTS = WIDTH / W;
+  for (std::size_t b = 0; b < nblocks; ++b)
+    for (int part = 0; part < PARTS; ++part) {
+      // input q of this part's lanes at [q * WIDTH + part * W]: every PARTS-th vector
+      const auto *block_in =
+          reinterpret_cast<const InMemory *>(in + b * N_INPUT * WIDTH + part * W);
+      auto *block_out = reinterpret_cast<InMemory *>(out + b * N_OUTPUT * WIDTH + part * W);
+      marshall_contact<InMemory, Vector, PARTS>(block_in, block_out, HISTORY_UPDATE);
+    }
 }
 
 // history_update as a constant: each path has one straight body per value
+template <int W>
 GCSIMD_ALWAYS_INLINE void lanes_body(std::size_t nblocks, const double *in, double *out,
                                      bool history_update)
 {
   if (history_update)
-    lanes_blocks<true>(nblocks, in, out);
+    lanes_blocks<W, true>(nblocks, in, out);
   else
-    lanes_blocks<false>(nblocks, in, out);
+    lanes_blocks<W, false>(nblocks, in, out);
 }
 
+// each path at its register width: SSE2 2 doubles, AVX2 4, AVX-512 8
 #define GC_LANES_PARAMS (std::size_t nblocks, const double *in, double *out, bool history_update)
-#define GC_LANES_ARGS (nblocks, in, out, history_update)
-GCSIMD_DEFINE_PATHS(void, lanes_kernel, GC_LANES_PARAMS, lanes_body, GC_LANES_ARGS)
+void lanes_kernel_generic GC_LANES_PARAMS { lanes_body<2>(nblocks, in, out, history_update); }
+#if GCSIMD_X86_DISPATCH
+GCSIMD_TARGET_AVX2 void lanes_kernel_avx2 GC_LANES_PARAMS
+{
+  lanes_body<4>(nblocks, in, out, history_update);
+}
+GCSIMD_TARGET_AVX512 void lanes_kernel_avx512 GC_LANES_PARAMS
+{
+  lanes_body<8>(nblocks, in, out, history_update);
+}
+#endif
+#undef GC_LANES_PARAMS
+using lanes_kernel_fn = void (*)(std::size_t, const double *, double *, bool);
+lanes_kernel_fn lanes_kernel_for(gcsimd::SimdPath path)
+{
+#if GCSIMD_X86_DISPATCH
+  if (path == gcsimd::SimdPath::AVX512) return lanes_kernel_avx512;
+  if (path == gcsimd::SimdPath::AVX2) return lanes_kernel_avx2;
+#endif
+  (void) path;
+  return lanes_kernel_generic;
+}
 
 }    // namespace
 

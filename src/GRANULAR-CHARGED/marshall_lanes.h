@@ -10,13 +10,14 @@
 // One Marshall contact (kinematics, JKR normal force from its root, damping, sliding, rolling,
 // twisting, torques), the one contact assembly of pair_style granular/opt and fix
 // wall/gran/opt (a wall is a fixed partner of radius 0 at rest), as a template on the number
-// type of marshall_kernels.h: double for one contact (the scalar kernel, the reference), Lanes for
-// WIDTH contacts at once (a GCC vector type, so the vector code needs no auto-vectoriser).
-// Every decision of a contact is a select (the double instantiation computes a value needed on
-// one side only where it is needed: NumberOps::only_where); the only branches of the lanes are
-// on history_update, the same for every contact of a step. A contact's inputs and outputs are flat arrays indexed by the
-// enums below; the lanes kernel reads them as structure-of-arrays blocks, WIDTH contacts of
-// each input next to each other. Free of LAMMPS classes.
+// type of marshall_kernels.h: double for one contact (the scalar kernel, the reference), a GCC
+// vector type of W doubles for W contacts at once (so the vector code needs no
+// auto-vectoriser). Every decision of a contact is a select (the double instantiation computes
+// a value needed on one side only where it is needed: NumberOps::only_where); the only branches
+// of the lanes are on history_update, the same for every contact of a step. A contact's inputs
+// and outputs are flat arrays indexed by the enums below; the lanes kernel reads them as
+// structure-of-arrays blocks, WIDTH contacts of each input next to each other, each SIMD path
+// as vectors of its register width. Free of LAMMPS classes.
 
 #ifndef LMP_GC_MARSHALL_LANES_H
 #define LMP_GC_MARSHALL_LANES_H
@@ -33,14 +34,28 @@ enum class SimdPath;    // gcsimd/simd.hpp: the instruction-set paths
 namespace LAMMPS_NS {
 namespace MarshallLanes {
 
-  // contacts per lane vector: one AVX-512 register of doubles, two AVX2 ones, four SSE2 ones
+  // contacts per lanes block of the buffers: one AVX-512 register of doubles
   constexpr int WIDTH = 8;
-  using Lanes = double __attribute__((vector_size(8 * WIDTH)));
-  using LaneMask = decltype(Lanes{} < Lanes{});
-  // the lanes in the blocks of the buffers: any alignment of a double, and read or written
-  // as doubles elsewhere
-  using LanesInMemory = double
-      __attribute__((vector_size(8 * WIDTH), aligned(alignof(double)), may_alias));
+  // a vector of W contacts' values (W = 2, 4 or 8: one SSE2, AVX2 or AVX-512 register) and its
+  // mask; each path evaluates a block as WIDTH / W such vectors, so that its values stay in
+  // registers
+  // (GCC drops a vector_size that depends on a template parameter: one definition per width)
+#define GC_LANES_OF(W)                                                                          \
+  template <> struct LanesOf<W> {                                                               \
+    using T = double __attribute__((vector_size(8 * W)));                                       \
+    using Mask = decltype(T{} < T{});                                                           \
+    using InMemory = double __attribute__((vector_size(8 * W), aligned(alignof(double)), may_alias)); \
+  };
+  // InMemory: T in the blocks of the buffers (any alignment of a double, and read or written
+  // as doubles elsewhere)
+  template <int W> struct LanesOf;
+  GC_LANES_OF(2)
+  GC_LANES_OF(4)
+  GC_LANES_OF(8)
+#undef GC_LANES_OF
+  using Lanes = LanesOf<WIDTH>::T;
+  using LaneMask = LanesOf<WIDTH>::Mask;
+  using LanesInMemory = LanesOf<WIDTH>::InMemory;
 }    // namespace MarshallLanes
 
 // GCC notes that a 64-byte vector passed by value has another ABI without AVX-512: these
@@ -48,18 +63,18 @@ namespace MarshallLanes {
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 namespace MarshallKernels {
-  // the lanes as a number type of the equations (marshall_kernels.h). The square root of a
-  // vector is one per lane, which GCC turns into one vector square root (the lanes code is
+  // lanes of W contacts as a number type of the equations (marshall_kernels.h). The square root
+  // of a vector is one per lane, which GCC turns into one vector square root (the lanes code is
   // compiled with -fno-math-errno); abs clears the sign bit, as fabs does.
-  template <> struct NumberOps<MarshallLanes::Lanes> {
-    using T = MarshallLanes::Lanes;
-    using Mask = MarshallLanes::LaneMask;
+  template <int W> struct LaneOps {
+    using T = typename MarshallLanes::LanesOf<W>::T;
+    using Mask = typename MarshallLanes::LanesOf<W>::Mask;
     static GC_KERNEL_INLINE T select(Mask c, T a, T b) { return c ? a : b; }
     template <class F> static GC_KERNEL_INLINE T only_where(Mask, F value) { return value(); }
     static GC_KERNEL_INLINE T sqrt(T x)
     {
       T r;
-      for (int k = 0; k < MarshallLanes::WIDTH; k++) r[k] = __builtin_sqrt(x[k]);
+      for (int k = 0; k < W; k++) r[k] = __builtin_sqrt(x[k]);
       return r;
     }
     static GC_KERNEL_INLINE T abs(T x)
@@ -68,6 +83,9 @@ namespace MarshallKernels {
       return __builtin_bit_cast(T, __builtin_bit_cast(Mask, x) & magnitude);
     }
   };
+  template <> struct NumberOps<MarshallLanes::LanesOf<2>::T> : LaneOps<2> {};
+  template <> struct NumberOps<MarshallLanes::LanesOf<4>::T> : LaneOps<4> {};
+  template <> struct NumberOps<MarshallLanes::LanesOf<8>::T> : LaneOps<8> {};
 }    // namespace MarshallKernels
 #pragma GCC diagnostic pop
 
@@ -134,12 +152,15 @@ namespace MarshallLanes {
      GranularModel::calculate_forces with the Marshall set, in its order of operations
   --------------------------------------------------------------------- */
 
-  template <class Memory, class T = Memory>
-  GC_KERNEL_INLINE void marshall_contact(const Memory *inputs, Memory *out, bool history_update)
+  // Memory: the type read and written (T, or T's unaligned twin); input q at inputs[q * STEP],
+  // output q at out[q * STEP] (STEP > 1: part of a wider lanes block)
+  template <class Memory, class T = Memory, int STEP = 1>
+  GC_KERNEL_INLINE void marshall_contact(const Memory *inputs, Memory *outputs, bool history_update)
   {
     namespace MK = MarshallKernels;
     using N = MK::NumberOps<T>;
-    auto in = [inputs](int q) -> T { return inputs[q]; };
+    auto in = [inputs](int q) -> T { return inputs[q * STEP]; };
+    auto out = [outputs](int q) -> Memory & { return outputs[q * STEP]; };
     const T dx[3] = {in(DX), in(DX + 1), in(DX + 2)};
     const T vr[3] = {in(VR), in(VR + 1), in(VR + 2)};
     const T radi = in(RAD_I), radj = in(RAD_J), reff = in(REFF);
@@ -217,13 +238,13 @@ namespace MarshallLanes {
     }
 
     for (int k = 0; k < 3; k++) {
-      out[FORCE + k] = force[k];
-      out[TORQUE_I + k] = torque_i[k];
-      out[TORQUE_J + k] = torque_j[k];
-      out[OUT_HIST_T + k] = hist_t[k];
-      out[OUT_HIST_R + k] = N::select(rolling, hist_r[k], in(HIST_R + k));
+      out(FORCE + k) = force[k];
+      out(TORQUE_I + k) = torque_i[k];
+      out(TORQUE_J + k) = torque_j[k];
+      out(OUT_HIST_T + k) = hist_t[k];
+      out(OUT_HIST_R + k) = N::select(rolling, hist_r[k], in(HIST_R + k));
     }
-    out[OUT_HIST_TW] = N::select(twisting, phi, in(HIST_TW));
+    out(OUT_HIST_TW) = N::select(twisting, phi, in(HIST_TW));
   }
 
   /* ---------------------------------------------------------------------
