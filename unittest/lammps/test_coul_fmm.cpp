@@ -969,6 +969,40 @@ TEST(CoulFMM, ToleranceScheduleIndependentOfRunSplit)
   EXPECT_LT(rel_rms(restarted, straight), 1e-10);
 }
 
+// charges created between two runs (the deposition deck's one-by-one insertion) are a known
+// change: the next run's first step evaluates them with the others, as fix deposit's insertion
+// within a run is, and the adapted interval and the other atoms' slopes go on. Started again,
+// the schedule would fall back to an interval of 1 after every insertion. The forces right
+// after an insertion are those of a fresh evaluation, and the checked error of the steps after
+// it stays within the tolerance (the fresh evaluation agrees to 4e-10 here, the shrink-wrapped
+// box of moving_charges; a field without the new charge is off by far more).
+TEST(CoulFMM, ToleranceScheduleGoesOnOverChargesAddedBetweenRuns)
+{
+  Lmp l;
+  moving_charges(l);
+  l.cmds({"fix fmm all coul/fmm accuracy 1e-6 every 32 near 6.0 tolerance 1e-4 check 3",
+          "run 60 post no"});
+  const double interval = l.var("f_fmm[8]"), evaluations = l.var("f_fmm[10]");
+  ASSERT_GT(interval, 1.0);
+  l.cmds({"create_atoms 1 single 10.3 9.7 36.0", "set atom 201 charge 1.0", "run 0 post no"});
+  ASSERT_EQ(l.var("count(all)"), 201.0);
+  EXPECT_EQ(l.var("f_fmm[8]"), interval);
+  EXPECT_EQ(l.var("f_fmm[10]"), evaluations + 1.0);    // the insertion's step, evaluated
+  l.cmd("run 40 post no");
+  std::printf("[ added between runs ] interval %g before, %g 40 steps after; checked error %.3g\n",
+              interval, l.var("f_fmm[8]"), l.var("f_fmm[7]"));
+  EXPECT_GT(l.var("f_fmm[8]"), 1.0);
+  EXPECT_LE(l.var("f_fmm[7]"), 1e-4);
+  l.cmds({"create_atoms 1 single 4.1 15.2 36.0", "set atom 202 charge -1.0", "run 0 post no"});
+  const double energy = l.var("f_fmm");
+  const auto forces = forces_by_id(l, 202);
+  const auto fresh = fresh_evaluation(l, "fmm", 202);
+  std::printf("[ added between runs ] energy %.10g vs fresh %.10g, forces %.3g\n", energy,
+              fresh.first, rel_rms(forces, fresh.second));
+  EXPECT_NEAR(energy, fresh.first, 1e-9 * std::fabs(fresh.first));
+  EXPECT_LT(rel_rms(forces, fresh.second), 1e-8);
+}
+
 // farfield average with a net-charged layer: the reported energy is the one whose gradient is
 // the applied force (the smeared far images act as an external field, so no 1/2 for their
 // part); central differences of the fix energy against the force on one atom in x and z
