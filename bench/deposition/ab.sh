@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The same deposition with two builds, started together (one per core), so that both see the
-# same machine: prints the user CPU seconds of each and their ratio, both GC RESULT lines and
-# whether they and the final dumps are identical.
+# same machine: prints the user CPU seconds of each and their ratio, both GC RESULT lines (and
+# GC COUL lines: fix coul/fmm's evaluations) and whether they and the final dumps are identical.
 #   bench/deposition/ab.sh <build-dir before> <build-dir after> [-var NAME VALUE ...]
 # e.g. bench/deposition/ab.sh /tmp/before build -var N 500 -var L_rp 14 -var q 400 -var seed 1
 # (a build dir holds lmp and liblammps.so.0; the deck is this checkout's, or for the build
@@ -30,6 +30,11 @@ for tag in before after; do
 done
 for tag in before after; do
   echo "$tag: $(grep '^GC RESULT' "$out/$tag/log.lammps" | tail -n 1)"
+done
+# fix coul/fmm's evaluations (charged runs only)
+for tag in before after; do
+  coul=$(grep '^GC COUL' "$out/$tag/log.lammps" | tail -n 1 || true)
+  [ -z "$coul" ] || echo "$tag: $coul"
 done
 if [ "$(grep '^GC RESULT' "$out/before/log.lammps" | tail -n 1)" = \
      "$(grep '^GC RESULT' "$out/after/log.lammps" | tail -n 1)" ]; then

@@ -58,11 +58,15 @@ void CoulFMMChargeScheme::init()
 
 // continue the schedule of the previous run (or of the restart file) when its stored field
 // still belongs to these atoms, charges and box: a run split into pieces, or continued from a
-// restart, then evaluates on the same steps as the uninterrupted run
+// restart, then evaluates on the same steps as the uninterrupted run. Charges added in between
+// (create_atoms, static sources woken) are a known change: the run's first step evaluates them
+// with the others, as an insertion within a run does, and the adapted interval and the other
+// atoms' slopes go on (started again, the interval would climb from 1 after every insertion).
 bool CoulFMMChargeScheme::continues()
 {
   eval->update_sleepers();
-  return p.state->continues(*p.stepping, eval->boundary(), [this](int i) { return eval->asleep(i); });
+  return p.state->continuation(*p.stepping, eval->boundary(),
+                               [this](int i) { return eval->asleep(i); }) != MTS::Continuity::NONE;
 }
 
 // due on the schedule's steps, whenever atoms were added or removed (fix deposit, evaporate:

@@ -64,7 +64,8 @@ class CoulFMMScheme {
   virtual ~CoulFMMScheme() noexcept(false) = default;    // as Pointers, which schemes derive from
   // checks of the settings against the other styles, and the solver (the fix's own checks done)
   virtual void init() = 0;
-  // at a run's setup: the stored state continues (else the schedule starts again)
+  // at a run's setup: the schedule goes on from the stored state (unchanged, or changed only by
+  // a known change that the first step evaluates); else it starts again
   virtual bool continues() = 0;
   // the forces of this step (CoulFMMState::force) and the fields; predict false: a minimizer's
   // trial positions (a fresh evaluation, nothing continued, whatever the keyword every).

@@ -169,10 +169,11 @@ CoulFMMTimeStepping::Continuity CoulFMMState::continuity(const CoulFMMTimeSteppi
 }
 
 // unwrapping after a remap may differ in the last bits, hence a tolerance
-bool CoulFMMState::continues(const CoulFMMTimeStepping &scheme, int boundary,
-                             const Predicate &asleep_now)
+MTS::Continuity CoulFMMState::continuation(const CoulFMMTimeStepping &scheme, int boundary,
+                                          const Predicate &asleep_now)
 {
-  if (continuity(scheme, boundary, asleep_now) != MTS::Continuity::SAME) return false;
+  const MTS::Continuity c = continuity(scheme, boundary, asleep_now);
+  if (c == MTS::Continuity::NONE) return c;
   const double tol = 1e-12 * std::max({domain->xprd, domain->yprd, domain->zprd});
   bool moved = false;
   double xu[3];
@@ -181,5 +182,5 @@ bool CoulFMMState::continues(const CoulFMMTimeStepping &scheme, int boundary,
     domain->unmap(atom->x[i], atom->image[i], xu);
     for (int k = 0; k < 3; k++) moved = moved || fabs(xu[k] - position_applied(i)[k]) > tol;
   }
-  return !mpi.any(moved);
+  return mpi.any(moved) ? MTS::Continuity::NONE : c;
 }

@@ -73,9 +73,10 @@ class CoulFMMState : protected Pointers {
   // how the stored evaluation relates to the atoms now
   CoulFMMTimeStepping::Continuity continuity(const CoulFMMTimeStepping &scheme, int boundary,
                                              const Predicate &asleep_now);
-  // at the start of a run: the stored field belongs to the same atoms, charges and box, and no
-  // atom was moved since the field was last applied (displace_atoms, set)
-  bool continues(const CoulFMMTimeStepping &scheme, int boundary, const Predicate &asleep_now);
+  // at the start of a run: continuity(), and NONE also when an atom of the evaluation was moved
+  // since the field was last applied (displace_atoms, set)
+  CoulFMMTimeStepping::Continuity continuation(const CoulFMMTimeStepping &scheme, int boundary,
+                                               const Predicate &asleep_now);
 
  private:
   int field_cols;

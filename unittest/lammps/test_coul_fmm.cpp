@@ -969,6 +969,45 @@ TEST(CoulFMM, ToleranceScheduleIndependentOfRunSplit)
   EXPECT_LT(rel_rms(restarted, straight), 1e-10);
 }
 
+// charges created between two runs (the deposition deck's one-by-one insertion) are a known
+// change: the next run's first step evaluates them with the others, as fix deposit's insertion
+// within a run is, and the adapted interval and the other atoms' slopes go on. Started again,
+// the schedule would fall back to an interval of 1 after every insertion. The forces right
+// after an insertion are those of a fresh evaluation (same solver settings, so to round-off),
+// and the checked error of the steps after it stays within the tolerance. Heavy atoms and
+// 1e-10 as in ToleranceAdaptsTheInterval (the charges depend on the number of ranks).
+TEST(CoulFMM, ToleranceScheduleGoesOnOverChargesAddedBetweenRuns)
+{
+  const std::string solver = "accuracy 1e-10 order 30";
+  Lmp l;
+  moving_charges(l);
+  l.cmds({"mass 1 100000.0",
+          "fix fmm all coul/fmm " + solver + " every 64 near 5.0 check 3 tolerance 1e-4",
+          "run 60 post no"});
+  const double interval = l.var("f_fmm[8]"), evaluations = l.var("f_fmm[10]");
+  ASSERT_GT(interval, 1.0);
+  l.cmds({"create_atoms 1 single 10.3 9.7 36.0", "set atom 201 charge 1.0", "run 0 post no"});
+  ASSERT_EQ(l.var("count(all)"), 201.0);
+  EXPECT_EQ(l.var("f_fmm[8]"), interval);
+  EXPECT_EQ(l.var("f_fmm[10]"), evaluations + 1.0);    // the insertion's step, evaluated
+  l.cmd("run 40 post no");
+  std::printf("[ added between runs ] interval %g before, %g 40 steps after; checked error %.3g\n",
+              interval, l.var("f_fmm[8]"), l.var("f_fmm[7]"));
+  EXPECT_GT(l.var("f_fmm[8]"), 1.0);
+  EXPECT_LE(l.var("f_fmm[7]"), 1e-4);
+  EXPECT_GT(l.var("f_fmm[7]"), 0.0);
+  l.cmds({"create_atoms 1 single 4.1 15.2 36.0", "set atom 202 charge -1.0", "run 0 post no"});
+  const double energy = l.var("f_fmm");
+  const auto forces = forces_by_id(l, 202);
+  l.cmds({"unfix fmm", "fix fresh all coul/fmm " + solver, "run 0 post no"});
+  const double fresh_energy = l.var("f_fresh");
+  const auto fresh = forces_by_id(l, 202);
+  std::printf("[ added between runs ] energy %.12g vs fresh %.12g, forces %.3g\n", energy,
+              fresh_energy, rel_rms(forces, fresh));
+  EXPECT_NEAR(energy, fresh_energy, 1e-10 * std::fabs(fresh_energy));
+  EXPECT_LT(rel_rms(forces, fresh), 1e-10);
+}
+
 // farfield average with a net-charged layer: the reported energy is the one whose gradient is
 // the applied force (the smeared far images act as an external field, so no 1/2 for their
 // part); central differences of the fix energy against the force on one atom in x and z
