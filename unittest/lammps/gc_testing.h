@@ -10,6 +10,8 @@
 #include "library.h"
 #include "variable.h"
 
+#include "gtest/gtest.h"
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -129,6 +131,25 @@ inline double rel_rms(const std::vector<double> &f, const std::vector<double> &r
     den += ref[k] * ref[k];
   }
   return std::sqrt(num / den);
+}
+
+// records of 6 values per atom and step (force, torque): each component within tol of the
+// largest of its kind (force or torque) over the whole record; natoms per step for the message
+inline void expect_same_forces(const std::vector<double> &a, const std::vector<double> &b,
+                               double tol, int natoms)
+{
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_GT(a.size(), 0u);
+  double scale[2] = {0.0, 0.0};
+  for (size_t k = 0; k < a.size(); ++k)
+    scale[(k % 6) / 3] = std::fmax(scale[(k % 6) / 3], std::fabs(a[k]));
+  int bad = 0;
+  for (size_t k = 0; k < a.size() && bad < 10; ++k)
+    if (!(std::fabs(a[k] - b[k]) <= tol * scale[(k % 6) / 3])) {
+      ++bad;
+      ADD_FAILURE() << "record " << k / 6 << " (step " << k / (6 * natoms) << ") component "
+                    << k % 6 << ": " << a[k] << " vs " << b[k];
+    }
 }
 
 // ---- JKR closed forms (doc/theory.md, eqs. (1.2)-(1.4)), independent of LAMMPS's implementation ----------

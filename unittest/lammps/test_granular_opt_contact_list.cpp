@@ -109,18 +109,7 @@ Recording recorded(Lmp &l, const std::string &tag)
 
 void expect_same_forces(const std::vector<double> &a, const std::vector<double> &b)
 {
-  ASSERT_EQ(a.size(), b.size());
-  ASSERT_GT(a.size(), 0u);
-  double scale[2] = {0.0, 0.0};
-  for (size_t k = 0; k < a.size(); ++k)
-    scale[(k % 6) / 3] = std::fmax(scale[(k % 6) / 3], std::fabs(a[k]));
-  int bad = 0;
-  for (size_t k = 0; k < a.size() && bad < 10; ++k)
-    if (!(std::fabs(a[k] - b[k]) <= TOL * scale[(k % 6) / 3])) {
-      ++bad;
-      ADD_FAILURE() << "record " << k / 6 << " (step " << k / (6 * NATOMS) << ") component "
-                    << k % 6 << ": " << a[k] << " vs " << b[k];
-    }
+  gctest::expect_same_forces(a, b, TOL, NATOMS);
 }
 
 LAMMPS_NS::PairGranularOpt *opt_pair(Lmp &l)
