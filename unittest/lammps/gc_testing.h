@@ -133,6 +133,28 @@ inline double rel_rms(const std::vector<double> &f, const std::vector<double> &r
   return std::sqrt(num / den);
 }
 
+// the values of every line "id v_1 ... v_ncols" of a text dump (read on this rank), in file order
+inline std::vector<double> dump_rows(const std::string &path, int ncols)
+{
+  std::vector<double> rows;
+  FILE *fp = fopen(path.c_str(), "r");
+  char line[1024];
+  while (fp && fgets(line, sizeof line, fp)) {
+    std::vector<double> v(ncols);
+    int id, used = 0, n = 0;
+    const char *p = line;
+    if (sscanf(p, "%d%n", &id, &used) != 1) continue;
+    p += used;
+    while (n < ncols && sscanf(p, "%lg%n", &v[n], &used) == 1) {
+      p += used;
+      n++;
+    }
+    if (n == ncols) rows.insert(rows.end(), v.begin(), v.end());
+  }
+  if (fp) fclose(fp);
+  return rows;
+}
+
 // records of 6 values per atom and step (force, torque): each component within tol of the
 // largest of its kind (force or torque) over the whole record; natoms per step for the message
 inline void expect_same_forces(const std::vector<double> &a, const std::vector<double> &b,

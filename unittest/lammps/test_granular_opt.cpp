@@ -79,15 +79,7 @@ std::vector<double> forces_per_step(Lmp &l, int steps, const std::string &tag)
   int me;
   MPI_Comm_rank(MPI_COMM_WORLD, &me);
   if (me == 0) {
-    FILE *fp = fopen(dump.c_str(), "r");
-    char line[512];
-    while (fp && fgets(line, sizeof line, fp)) {
-      int id;
-      double v[6];
-      if (sscanf(line, "%d %lg %lg %lg %lg %lg %lg", &id, v, v + 1, v + 2, v + 3, v + 4, v + 5) == 7)
-        s.insert(s.end(), v, v + 6);
-    }
-    if (fp) fclose(fp);
+    s = gctest::dump_rows(dump, 6);
     std::remove(dump.c_str());
   }
   int n = (int) s.size();

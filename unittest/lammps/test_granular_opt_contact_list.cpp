@@ -80,16 +80,9 @@ Recording recorded(Lmp &l, const std::string &tag)
   l.cmd("unfix nc");
   Recording r;
   if (gctest::rank() == 0) {
-    FILE *fp = fopen(dump.c_str(), "r");
+    r.forces = gctest::dump_rows(dump, 6);
+    FILE *fp = fopen(counts.c_str(), "r");
     char line[512];
-    while (fp && fgets(line, sizeof line, fp)) {
-      int id;
-      double v[6];
-      if (sscanf(line, "%d %lg %lg %lg %lg %lg %lg", &id, v, v + 1, v + 2, v + 3, v + 4, v + 5) == 7)
-        r.forces.insert(r.forces.end(), v, v + 6);
-    }
-    if (fp) fclose(fp);
-    fp = fopen(counts.c_str(), "r");
     while (fp && fgets(line, sizeof line, fp)) {
       double c;
       if (line[0] != '#' && sscanf(line, "%lg", &c) == 1) r.contacts.push_back(c);
