@@ -41,6 +41,8 @@ MAX_REDRAWS = 20000         # the deck's bound on the redraws of one particle's 
 E0 = 1.602176634e-19
 MAX_SIGMA = 1e-2            # |surface charge density| [C/m^2]: a surface field of ~1e9 V/m
 MIN_STEPS_OF_FLIGHT = 100   # the time step is at most this fraction of the fall from H
+MAX_CONTACT_POTENTIAL = 10.0  # |contact potential| [V]: work functions differ by a few V at most
+TRIBO_Z0 = (1e-11, 1e-6)    # the cut-off gap z0 [m]: from a tenth of an atom's size to 1 um
 
 
 def suffix(s: int) -> str:
@@ -125,6 +127,17 @@ def _charge_rule(name: str, radius: str, when: str = "") -> list:
           plausible=True, when=when)]
 
 
+def _potential_rules(name: str, what: str, gate: str = "") -> list:
+    """A contact potential (work function / e) [V]: a number, and at most a few volts (a value
+    in mV given as volts is refused, with the volts it probably meant)."""
+    return [
+        N(name, "v_@ == v_@", f"a number [V] ({what})", when=gate),
+        N(name, f"abs(v_@) <= {MAX_CONTACT_POTENTIAL:g}",
+          f"a contact potential of ${{@}} V, above {MAX_CONTACT_POTENTIAL:g} V; contact "
+          "potentials are volts, a few V at most ($(v_@/1000:%.3g) for ${@} mV)",
+          plausible=True, when=gate)]
+
+
 def _table() -> list:
     R = []
     sp = "${{species}} >= {n}"
@@ -180,7 +193,16 @@ def _table() -> list:
             "a whole number of particles >= 0 (0: no restart points)"),
           N("checkpoint_stop", WHOLE + " && v_@ >= 0", "a whole number of particles >= 0"),
           N("computes", "v_@ == 0 || v_@ == 1", "0 or 1"),
-          N("progress", WHOLE + " && v_@ >= 0", "a whole number of particles >= 0 (0: N/50)")]
+          N("progress", WHOLE + " && v_@ >= 0", "a whole number of particles >= 0 (0: N/50)"),
+          W("tribo", YESNO), W("tribo_field", YESNO),
+          N("tribo_z0", "v_@ > 0", "> 0 [m] (the cut-off gap of the condenser model)"),
+          N("tribo_z0", f"v_@ <= {TRIBO_Z0[1]:g}",
+            "a cut-off gap of ${@} m, above 1 um; z0 is in metres ($(v_@*1e-10:%.3g) for "
+            "${@} Angstrom, $(v_@*1e-9:%.3g) for ${@} nm)", plausible=True),
+          N("tribo_z0", f"v_@ >= {TRIBO_Z0[0]:g}",
+            "a cut-off gap of ${@} m, below 0.1 Angstrom (z0 is a gap of a few atoms, "
+            "4e-10 m); z0 is in metres", plausible=True)]
+    R += _potential_rules("tribo_V_wall", "the contact potential of the floor")
     # ---- each species: fraction, material, size and charge rules --------------------------
     for s in SPECIES:
         x = suffix(s)
@@ -276,6 +298,7 @@ def _table() -> list:
                 "a fraction in [0, 1] (of the positive particles)", when=gate)]
         R += _charge_rule(f"q{x}", f"rp{x}", when=gate)
         R += _charge_rule(f"q_sd{x}", f"rp{x}", when=gate)
+        R += _potential_rules(f"tribo_V{x}", f"the contact potential of species {s}", gate)
         R += [N(f"q_sigma{x}", f"abs(v_@) <= {MAX_SIGMA}",
                 f"a surface charge density of ${{q_sigma{x}}} C/m^2, above {MAX_SIGMA} C/m^2 "
                 f"(a surface field of 1e9 V/m); densities are in C/m^2 "

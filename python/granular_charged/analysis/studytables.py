@@ -3,7 +3,9 @@ a column `study`: runs.csv (one row per run: the grid values, seed, particles as
 settled, phi, <Z>, ...), summary.csv (mean and sd over the seeds per grid point, with the runs
 that did not settle or made fewer particles than asked), species.csv and species_summary.csv
 (per species of every run and grid point: its share of the particles, its contribution to phi,
-its <Z> and f(Z)), classes.csv (<Z> per species and size class).
+its <Z> and f(Z)), classes.csv (<Z> per species and size class); with contact charging
+(tribo yes) charges.csv, charges_summary.csv, charge_depth.csv and charge_depth_summary.csv
+(charge_tables).
 
 Also what the study's figures share: the names of the grid's axes (grid_names), a run's point
 on the grid (point, point_label) and the unit of a deck variable (unit, axis_label)."""
@@ -30,7 +32,7 @@ UNITS = {"rp": "m", "rp_lo": "m", "rp_hi": "m", "radii": "m", "U0": "m/s", "gamm
          "frac": "-", "rfrac": "-", "q_pos": "-", "L_rp": "r_p", "H_rp": "r_p", "gap_rp": "r_p",
          "seq_gap_rp": "r_p", "zlo_rp": "r_p", "top_rp": "r_p", "seq_dz_L": "L", "dt_div": "-",
          "ke_stop": "-", "settle_max": "r_p/U0", "N": "particles", "species": "-",
-         "seed": "-"}
+         "seed": "-", "tribo_V": "V", "tribo_V_wall": "V", "tribo_z0": "m"}
 
 
 def unit(name: str) -> str:
@@ -211,7 +213,7 @@ def study_tables(d: dict, results: list[dict], out: Path) -> tuple[pd.DataFrame,
     name = d["name"]
     names = grid_names(d)
     spn = species_names(d)
-    rows, cls, spr = [], [], []
+    rows, cls, spr, chg, dep = [], [], [], [], []
     for r in results:
         py = r.get("python") or {}
         gv = dict(zip(names, point(r, names)))
@@ -223,6 +225,10 @@ def study_tables(d: dict, results: list[dict], out: Path) -> tuple[pd.DataFrame,
         rows.append(row)
         if row["warning"]:
             log.warning("%s (%s): %s", r["key"], point_label(names, gv.values()), row["warning"])
+        for c in (r.get("charges") or {}).get("stats", []):
+            chg.append({**base, "species_name": _species_name(c["species"], spn), **c})
+        for c in (r.get("charges") or {}).get("depth", []):
+            dep.append({**base, "species_name": _species_name(c["species"], spn), **c})
         for c in py.get("classes", []):
             cls.append({**base, "species_name": spn.get(int(c["species"]), f"species {c['species']}"),
                         **{k: c[k] for k in ("species", "class", "r_lo", "r_hi", "n", "Z")}})
@@ -267,4 +273,38 @@ def study_tables(d: dict, results: list[dict], out: Path) -> tuple[pd.DataFrame,
                    phi=("phi", "mean"), phi_sd=("phi", "std"), Z=("Z", "mean"),
                    Z_sd=("Z", "std")).reset_index())
         ss.to_csv(out / "species_summary.csv", index=False)
+    charge_tables(chg, dep, names, out)
     return runs, summ
+
+
+def _species_name(s, spn: dict) -> str:
+    return "all" if s == "all" else spn.get(int(s), f"species {s}")
+
+
+def charge_tables(chg: list[dict], dep: list[dict], names: list[str], out: Path):
+    """The final charges of the runs with contact charging (result.json's 'charges'):
+    charges.csv (per run and species: n, mean, sd, median, extremes, fractions negative and
+    positive, total [e0]), charge_depth.csv (per run, species and depth bin), and over the seeds
+    charges_summary.csv (per grid point and species: the mean of the runs' mean charges, their
+    sd over the seeds, the mean sd within a run, the mean fraction negative) and
+    charge_depth_summary.csv (per grid point, species and depth bin: the particles' mean charge,
+    pooled over the seeds). Nothing without such runs."""
+    if not chg:
+        return
+    keys = ["study", *names, "species", "species_name"]
+    c = pd.DataFrame(chg)
+    c["species"] = c["species"].astype(str)
+    c.to_csv(out / "charges.csv", index=False)
+    (c.groupby(keys, dropna=False, sort=True)
+     .agg(runs=("seed", "count"), n=("n", "sum"), q_mean_e0=("q_mean_e0", "mean"),
+          q_mean_sd_e0=("q_mean_e0", "std"), q_sd_e0=("q_sd_e0", "mean"),
+          frac_negative=("frac_negative", "mean"))
+     .reset_index().to_csv(out / "charges_summary.csv", index=False))
+    d = pd.DataFrame(dep)
+    d["species"] = d["species"].astype(str)
+    d.to_csv(out / "charge_depth.csv", index=False)
+    d["q_sum"] = d["q_mean_e0"] * d["n"]
+    g = (d.groupby(keys + ["depth_lo_rp", "depth_hi_rp", "depth_rp"], dropna=False, sort=True)
+         .agg(runs=("seed", "count"), n=("n", "sum"), q_sum=("q_sum", "sum")).reset_index())
+    g["q_mean_e0"] = g["q_sum"] / g["n"]
+    g.drop(columns=["q_sum"]).to_csv(out / "charge_depth_summary.csv", index=False)

@@ -87,6 +87,22 @@ def deck_options(p: argparse.ArgumentParser, many: bool):
     p.add_argument("--inject", choices=["auto", "rain", "plane", "sequential"], default="auto",
                    help="injection protocol (auto: rain when no particle is charged, plane when "
                         "any is; doc/deposition.md)")
+    g = p.add_argument_group("contact charging (fix tribo/charge; doc/populations.md, "
+                             "\"Contact charging\")")
+    g.add_argument("--tribo", action="store_true",
+                   help="contacts charge the particles (in.deposition's tribo yes); the "
+                        "injected particles keep their charge rule (--q 0: neutral)")
+    g.add_argument("--tribo-V", nargs="+", default=None, metavar="V",
+                   help="contact potential (work function / e) [V] of species 1, 2, 3 in "
+                        "order (tribo_V, tribo_V_2, tribo_V_3; a species not given has species "
+                        "1's); only differences matter (default 0)")
+    g.add_argument("--tribo-V-wall", default=None, metavar="V",
+                   help="the floor's contact potential [V] (tribo_V_wall, default 0)")
+    g.add_argument("--tribo-z0", default=None, metavar="M",
+                   help="cut-off gap z0 of the condenser model [m] (tribo_z0, default 4e-10)")
+    g.add_argument("--tribo-field", choices=["yes", "no"], default=None,
+                   help="yes: the normal field at a contact reduces the transfer (tribo_field, "
+                        "default yes)")
     p.add_argument("--tracer", type=int, default=0, help="follow this particle id (Fig. 8)")
     p.add_argument("--checkpoint", type=int, default=0, metavar="K",
                    help="plane and sequential injection: a restart point every K particles; an "
@@ -161,8 +177,47 @@ def refused(command: str) -> dict:
     return dict(RESERVED, **own)
 
 
+# the contact-charging options and their deck variables (--tribo-V: one per species)
+TRIBO_OPTIONS = {"tribo_V_wall": "tribo_V_wall", "tribo_z0": "tribo_z0",
+                 "tribo_field": "tribo_field"}
+
+
+def tribo_vars(a) -> dict:
+    """Deck variables of --tribo and its values (none when not given); ParamError for values
+    without --tribo (the deck would not read them) and for more potentials than species."""
+    v = {}
+    potentials = getattr(a, "tribo_V", None) or []
+    given = [f"--{k.replace('_', '-')}" for k in ("tribo_V", *TRIBO_OPTIONS)
+             if getattr(a, k, None) is not None]
+    if not getattr(a, "tribo", False):
+        if given:
+            raise ParamError(f"{given[0]}: contact charging's values are read with --tribo only")
+        return v
+    v["tribo"] = "yes"
+    if len(potentials) > 3:
+        raise ParamError(f"--tribo-V {' '.join(potentials)}: one contact potential per species, "
+                         "at most 3")
+    for s, value in enumerate(potentials, start=1):
+        v["tribo_V" + ("" if s == 1 else f"_{s}")] = value
+    for opt, name in TRIBO_OPTIONS.items():
+        if getattr(a, opt, None) is not None:
+            v[name] = getattr(a, opt)
+    return v
+
+
+def check_species_values(p):
+    """ParamError for a contact potential of a species the run does not have (--tribo-V with
+    more values than species: the deck would not read them)."""
+    n = int(float(p.extra.get("species", 1)))
+    extra = [k for k in ("tribo_V_2", "tribo_V_3") if k in p.extra and int(k[-1]) > n]
+    if extra:
+        raise ParamError(f"{extra[0]} = {p.extra[extra[0]]}: the run has {n} species "
+                         f"(--var species {int(extra[0][-1])} for more)")
+
+
 def population_vars(a) -> dict:
-    """Deck variables of --size, --charge, --inject (none when not given)."""
+    """Deck variables of --size, --charge, --inject and the contact-charging options (none when
+    not given)."""
     v = {}
     if getattr(a, "size", None) or getattr(a, "charge", None):
         rp = a.rp[0] if isinstance(a.rp, list) else a.rp
@@ -174,6 +229,7 @@ def population_vars(a) -> dict:
             v.pop("rp", None)          # one radius: --rp (a sweep's axis) stays
     if getattr(a, "inject", "auto") != "auto":
         v["inject"] = a.inject
+    v.update(tribo_vars(a))
     return v
 
 

@@ -31,6 +31,7 @@ def run(a) -> int:
     p = deck_params(single, dict(rp=a.rp, U0=a.U0, gamma=a.gamma, q=a.q),
                     options.population_vars(a), options.refused("run"), a.N, a.seed)
     Runner.check(p, a.tracer)
+    options.check_species_values(p)
     log.info("injection protocol: %s%s", protocol(p.deck_vars()),
              " (auto: rain when no particle is charged, plane when any is)"
              if a.inject == "auto" else "")
@@ -48,5 +49,14 @@ def run(a) -> int:
     state = "finished before (not run again)" if r["skipped"] else f"{r['wall_s']:.1f} s"
     log.info("%s: phi = %s, <Z> = %s, %d atoms, lost %d, flying %d (%s)", p.key(),
              fmt(r["phi"], ".4f"), fmt(r["Z"], ".3f"), r["natoms"], r["lost"], r["flying"], state)
+    if r.get("tribo"):
+        t = r["tribo"]
+        log.info("%s: contact charging moved %.4g C between particles, the floor gave %+.4g C "
+                 "(%d pair and %d wall charging events)", p.key(), t["moved_C"], t["wall_C"],
+                 t["pair_events"], t["wall_events"])
+    if r.get("charges"):
+        # matplotlib only when there is a figure to draw: the command line starts without it
+        from ..figures.charges import run_figure
+        log.info("final charges: %s", run_figure(r))
     print((Path(r["dir"]) / "result.json").resolve())
     return 0

@@ -36,6 +36,7 @@ def run(a) -> int:
                           a.N, a.seeds)
     for p in params:
         Runner.check(p, a.tracer)
+        options.check_species_values(p)
     announce(params, a.out, a.inject)
     out = options.out_dir(a.out)
     figs = options.out_dir(a.figures, "--figures") if a.figures else None

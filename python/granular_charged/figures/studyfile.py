@@ -8,7 +8,10 @@ data as CSV beside it (with the study's name in a column `study`):
   first seed);
 - force_pdf.png: the pdf of the normal contact forces F_n / F_C per grid point (all seeds);
 - point_<k>.png per grid point: f(Z) overall and per species, <Z> per size class, the normal
-  force pdf, titled with that point's own grid values and charges.
+  force pdf, titled with that point's own grid values and charges;
+- charges_<k>.png per grid point whose runs have contact charging (tribo yes): per species the
+  histogram of the final charges and the mean charge against the depth below the bed top
+  (figures.charges).
 
 Titles name the study, what all runs share (material, protocol, N) and, in each figure of one
 point, that point's values; they wrap to the figure's width (constrained layout: nothing
@@ -355,4 +358,23 @@ def study_figures(d: dict, results: list[dict], out: Path) -> list[Path]:
     paths.append(force_figure(d, out, label, pts, forces))
     for k, (key, runs) in enumerate(pts.items(), start=1):
         paths.append(point_figure(d, out, k, key, runs, per_species, forces[key]))
+        if any(r.get("charges") for r in runs):
+            paths.append(charges_figure(d, out, k, key, [r for r in runs if r.get("charges")]))
     return [p for p in paths if p is not None]
+
+
+def charges_figure(d, out: Path, k: int, key: tuple, runs: list[dict]) -> Path | None:
+    """charges_<k>.png: the final charges of a grid point's runs with contact charging (their
+    particles pooled over the seeds), per species (figures.charges)."""
+    from .charges import charge_figure, particles_of
+    names = grid_names(d)
+    try:
+        df = particles_of(runs)
+    except (OSError, ValueError, KeyError, IndexError) as e:
+        log.warning("study figure charges_%d: %s", k, e)
+        return None
+    plab = point_label(names, key)
+    seeds = ", ".join(str(r["params"]["seed"]) for r in runs)
+    title = (f"{d['name']}: {plab + '; ' if plab else ''}final charges after contact charging, "
+             f"seeds {seeds} pooled")
+    return charge_figure(df, out / f"charges_{k}.png", title, species_names(d), study=d["name"])

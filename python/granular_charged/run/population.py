@@ -25,6 +25,9 @@ SIZE_KEYS = {"one": ("r",), "uniform": ("lo", "hi"), "lognormal": ("median", "gs
 CHARGE_KEYS = {"fixed": ("q",), "area": ("sigma",), "gauss": ("q", "sigma", "sd"),
                "bipolar": ("q", "sigma", "pos")}
 MATERIAL_KEYS = ("rho", "E", "nu", "gamma", "e", "mu")
+# a species' surface for contact charging (in.deposition's tribo_V, tribo_V_2, ...): its contact
+# potential [V], given in the material of a study file's species
+SURFACE_KEYS = ("tribo_V",)
 MAX_SPECIES = 3
 MAX_RADII = 6
 
@@ -159,9 +162,9 @@ def species_vars(s: int, size: dict, charge: dict | None, material: dict | None 
             if key in charge:
                 v[var + suf] = _num(charge[key])
     for k, val in (material or {}).items():
-        if k not in MATERIAL_KEYS:
+        if k not in MATERIAL_KEYS + SURFACE_KEYS:
             raise ParamError(f"species {s}: material has no {k!r} (it takes "
-                             f"{', '.join(MATERIAL_KEYS)})")
+                             f"{', '.join(MATERIAL_KEYS + SURFACE_KEYS)})")
         try:
             v[k + suf] = _num(float(val))
         except (TypeError, ValueError):
@@ -233,6 +236,8 @@ def describe(vars_: dict) -> dict:
         charge = {"dist": qd, "q": float(g("q", 0.0)), "sigma": float(g("q_sigma", 0.0)),
                   "sd": float(g("q_sd", 0.0)), "pos": float(g("q_pos", 0.5))}
         material = {k: float(g(k, getattr(DepositionParams, k))) for k in MATERIAL_KEYS}
+        if str(vars_.get("tribo", "no")) == "yes":
+            material["tribo_V"] = float(g("tribo_V", 0.0))
         out.append({"fraction": fr[s - 1] / sum(fr), "size": size, "charge": charge,
                     "material": material})
     return {"species": out}

@@ -28,7 +28,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from ..analysis import packing
+from ..analysis import charges, packing
 from ..params import DepositionParams, ParamError, coulomb_to_adhesion
 from . import child, estimate, population
 from .deckfile import deck_path, deck_variables
@@ -322,6 +322,11 @@ def write_params(wd: Path, p: DepositionParams):
                                         "deck_vars": p.deck_vars()})
 
 
+def tribo_on(deck_vars: dict) -> bool:
+    """Whether a run's deck variables switch contact charging on (in.deposition's tribo)."""
+    return str(deck_vars.get("tribo", "no")) == "yes"
+
+
 def parse_progress(line: str) -> dict | None:
     """{'k', 'N', 'step', 'elapsed', 'eta'} of a GC PROGRESS line of in.deposition:
     'GC PROGRESS k / N particles, step S, elapsed T s, eta T s'."""
@@ -530,6 +535,10 @@ class Runner:
             shutil.rmtree(wd)
         if population.is_charged(p.deck_vars()) and not self.build.capabilities["coul/fmm"]:
             raise RunError(f"{p.key()}: charged runs need fix coul/fmm, absent from {self.build.path}")
+        if tribo_on(p.deck_vars()) and not (self.build.capabilities["coul/fmm"]
+                                            and self.build.capabilities.get("tribo/charge")):
+            raise RunError(f"{p.key()}: tribo yes (contact charging) needs fix tribo/charge and "
+                           f"fix coul/fmm, absent from {self.build.path}")
         variables = p.deck_vars()
         variables["out"] = "."
         # the one-by-one protocols' short runs in log.inject.lammps, the run's own log small
@@ -673,6 +682,12 @@ class Runner:
         }
         if population.is_population(p.deck_vars()):
             res["python"].update(packing.by_class(snap, res["population"], py["zlo"], py["zhi"]))
+        if tribo_on(p.deck_vars()):
+            # contact charging: the fix's counters, the final charges per species and against
+            # the depth below the bed top (tables in the run's folder)
+            res["tribo"] = lmp.get("tribo")
+            res["charges"] = charges.analyse(snap, p.rp)
+            charges.write_tables(res["charges"], workdir)
         warnings = [ana["warning"]] if "warning" in ana else []
         if lmp["inserted"] < p.N:
             # inject sequential stops when the bed's charge turns the next particle back

@@ -19,7 +19,8 @@ def deck_params(pairs, base: dict, popvars: dict, refused: dict, N: int, seed: i
     names = {n for n, _ in pairs}
     clash = sorted(names & set(popvars))
     if clash:
-        raise ParamError(f"--var {clash[0]}: set by --size/--charge/--inject or the population")
+        raise ParamError(f"--var {clash[0]}: set by --size/--charge/--inject/--tribo* or the "
+                         "population")
     fields, extra = split_deck_vars(list(pairs), deck_variables("in.deposition"), refused)
     fields = dict(base, **fields)
     for k, v in popvars.items():
