@@ -87,8 +87,8 @@ def deck_options(p: argparse.ArgumentParser, many: bool):
     p.add_argument("--inject", choices=["auto", "rain", "plane", "sequential"], default="auto",
                    help="injection protocol (auto: rain when no particle is charged, plane when "
                         "any is; doc/deposition.md)")
-    g = p.add_argument_group("contact charging (fix tribo/charge; doc/populations.md, "
-                             "\"Contact charging\")")
+    g = p.add_argument_group("contact charging (fix tribo/charge)",
+                             "doc/populations.md, section Contact charging")
     g.add_argument("--tribo", action="store_true",
                    help="contacts charge the particles (in.deposition's tribo yes); the "
                         "injected particles keep their charge rule (--q 0: neutral)")

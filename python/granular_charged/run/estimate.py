@@ -16,10 +16,11 @@ N_dep is N, or for a charged bed the particles made before the bed's charge turn
 back (the deck's barrier of the plane and sequential protocols: particle k cannot reach its
 start height h once 2 pi k_e q_k Q_bed / (L^2 m_k) >= g + U_0^2 / (2 (H - h)); E* >= 1 of
 params.dimensionless for one kind of particle is the same barrier at the paper's scale); the
-estimate then warns. c is per kind (neutral, charged: the Coulomb solver's work), fitted on
-this machine (bench/estimate/estimate_vs_actual.py) and refined by the finished runs found under
-the given folders (the geometric mean of their c from their actual steps, when there are two
-or more of the kind). The factor of uncertainty is that of the fit, or the geometric sd of the
+estimate then warns. c is per kind (neutral, charged: the Coulomb solver's work; a run with
+contact charging, tribo yes, is of the charged kind, fix coul/fmm working on the charges its
+contacts make), fitted on this machine (bench/estimate/estimate_vs_actual.py) and refined by the
+finished runs found under the given folders (the geometric mean of their c from their actual
+steps, when there are two or more of the kind). The factor of uncertainty is that of the fit, or the geometric sd of the
 runs' c when larger.
 
 Nothing here raises on odd inputs: a value the model cannot use gives no estimate ('cpu_s'
@@ -164,6 +165,12 @@ def settle_steps_rp(p: DepositionParams) -> float:
     return min(max(SETTLE_G * abs(g) * float(p.rp) / float(p.U0) ** 2, SETTLE_MIN), smax)
 
 
+def coulomb_works(v: dict) -> bool:
+    """Whether fix coul/fmm works in a run (deck variables v): charged particles, or contact
+    charging (tribo yes: the charges made by contacts); the kind of its calibration."""
+    return population.is_charged(v) or str(v.get("tribo", "no")) == "yes"
+
+
 def plan(p: DepositionParams, dt: float | None = None) -> dict:
     """The steps of run p by the deck's rules: protocol, dt, injection interval n_i, steps per
     r_p / U_0 of fall, particles deposited (N_dep), the steps of injection, fall and settling,
@@ -210,7 +217,8 @@ def plan(p: DepositionParams, dt: float | None = None) -> dict:
     inject = n_dep * n_i
     post = (fall_rp + settle_rp) * unit
     work = n_i * n_dep * n_dep / 2.0 + n_dep * post
-    return {"protocol": proto, "charged": charged, "dt": dt, "unit": unit, "n_i": n_i,
+    return {"protocol": proto, "charged": charged, "coulomb": coulomb_works(v), "dt": dt,
+            "unit": unit, "n_i": n_i,
             "N": N, "N_dep": n_dep, "inject_steps": inject, "fall_steps": fall_rp * unit,
             "settle_steps": settle_rp * unit, "steps": inject + post, "work": work,
             "barrier": bar}
@@ -266,7 +274,7 @@ def calibration(folders) -> dict:
             w = actual_work(p, r)
             if w and w > 0:
                 try:
-                    cs[population.is_charged(p.deck_vars())].append(cpu / w)
+                    cs[coulomb_works(p.deck_vars())].append(cpu / w)
                 except Exception:       # noqa: BLE001
                     continue
     out = {}
@@ -302,7 +310,7 @@ def estimate(params, folders=()) -> dict:
                 none.append(str(p))
             continue
         protocols[pl["protocol"]] = protocols.get(pl["protocol"], 0) + 1
-        c, f, k = cal[pl["charged"]]
+        c, f, k = cal[pl["coulomb"]]
         steps += pl["steps"]
         settle += pl["fall_steps"] + pl["settle_steps"]
         cpu += c * pl["work"]
@@ -326,7 +334,7 @@ def cpu_seconds(params, folders=()) -> list[tuple[float, float]]:
         if pl is None:
             out.append((DEFAULT_C[True] * 1e6, 10.0))
             continue
-        c, f, _ = cal[pl["charged"]]
+        c, f, _ = cal[pl["coulomb"]]
         out.append((c * pl["work"], f))
     return out
 
