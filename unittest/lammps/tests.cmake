@@ -41,3 +41,5 @@ add_dependencies(test_marshall_lanes lmp)
 # granular/opt's contact list kept between neighbor-list builds against granular: contacts made
 # and broken between builds, radii changed by fix adapt and by set between runs
 gc_lammps_test(test_granular_opt_contact_list NP 1 2 SOURCES test_granular_opt_contact_list.cpp)
+# fix tribo/charge against the condenser model's closed forms, charge conservation on 1 and 2 ranks
+gc_lammps_test(test_tribo_charge NP 1 2 SOURCES test_tribo_charge.cpp)
