@@ -362,7 +362,10 @@ def test_a_bipolar_binary_charges_by_its_potentials(tribo_build, tmp_path, injec
     """The population's protocols (rain: one by one; plane; sequential): fix coul/fmm is
     defined although every particle starts neutral; charge is conserved; species 2 (higher
     potential) ends negative on average and species 1 positive."""
-    text = lmp_run(tribo_build, DECK, tmp_path, dict(BIPOLAR, inject=inject))
+    # plane, sequential: H = 60 r_p (the start plane, 7 r_p above the bed top, stays in the box
+    # even when a pair of opposite charges hovers high above the 16 particles' bed)
+    text = lmp_run(tribo_build, DECK, tmp_path,
+                   dict(BIPOLAR, inject=inject, H_rp=30 if inject == "rain" else 60))
     assert re.search(r"^fix coul all coul/fmm", text, re.M)
     assert re.search(r"^fix tribo all tribo/charge z0 4e-10 potential 0 0.5 wall floor 0.2 "
                      r"wall floor2 0.2 field yes", text, re.M), "the fix as the deck makes it"
