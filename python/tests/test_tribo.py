@@ -419,8 +419,15 @@ def test_a_run_records_and_analyses_its_charges(tribo_build, tmp_path):
         assert st[s]["n"] == len(qs) and st[s]["q_mean_e0"] == pytest.approx(qs.mean(), rel=1e-9)
         assert st[s]["frac_negative"] == (qs < 0).mean()
     assert [m["material"]["tribo_V"] for m in res["population"]["species"]] == [0.0, 0.5]
-    for name in ("charges.csv", "charge_depth.csv", "charge_hist.csv", "charges.png"):
+    # the depth profile of the run's particles with r_p = 2 um, bins of 2 r_p
+    df = charges.particles(packing.read_dump(wd / "final.dump", last_only=True), 2e-6)
+    assert res["charges"]["depth"] == json.loads(json.dumps(charges.depth_profile(df)))
+    assert sum(r["n"] for r in res["charges"]["depth"] if r["species"] == "all") == 16
+    for name in ("charges.csv", "charge_depth.csv", "charge_hist.csv",
+                 "charge_distribution.png", "charge_distribution.csv"):
         assert (wd / name).exists(), name
+    header = (wd / "charges.csv").read_text().splitlines()[0]
+    assert header.startswith("species,n,q_mean_e0,q_sd_e0"), header
 
 
 def test_restart_points_carry_the_contact_charging(tribo_build, tmp_path):

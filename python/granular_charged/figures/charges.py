@@ -81,7 +81,8 @@ def charge_figure(df: dict, path: Path, title: str, names: dict | None = None,
 
 
 def run_figure(result: dict) -> Path | None:
-    """charges.png in a finished run's folder (a run with contact charging; None otherwise)."""
+    """charge_distribution.png (its data in charge_distribution.csv) in a finished run's folder
+    (a run with contact charging; None otherwise)."""
     if not result.get("charges"):
         return None
     t = result.get("tribo") or {}
@@ -89,4 +90,5 @@ def run_figure(result: dict) -> Path | None:
     title = (f"{result['key']}: final charges after contact charging (moved "
              f"{t.get('moved_C', float('nan')) / e0:.4g} e0 between particles, the floor gave "
              f"{t.get('wall_C', float('nan')) / e0:+.4g} e0)")
-    return charge_figure(particles_of([result]), Path(result["dir"]) / "charges.png", title)
+    return charge_figure(particles_of([result]), Path(result["dir"]) / "charge_distribution.png",
+                         title)
