@@ -449,3 +449,10 @@ def test_restart_points_carry_the_contact_charging(tribo_build, tmp_path):
     t_split = _tribo_line(lmp_run(tribo_build, DECK, split, dict(v, out=".", resume="yes")))
     assert t_split == t_whole
     assert (split / "final.dump").read_text() == (whole / "final.dump").read_text()
+
+
+def test_a_run_charged_by_contacts_is_labelled_so():
+    r = {"params": {"q": 0.0, "extra": {"tribo": "yes"}}}
+    assert studytables.charge_label(r) == "injected uncharged, charged by contacts"
+    r = {"params": {"q": 100.0, "extra": {}}}
+    assert studytables.charge_label(r) == "q 100 e0"

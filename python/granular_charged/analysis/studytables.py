@@ -140,7 +140,15 @@ def charges(v: dict) -> list[dict]:
 
 def charge_label(r: dict, names: dict | None = None) -> str:
     """The charges of a run, as the run has them: 'uncharged', or per species (named by names,
-    {species number: name}) the rule and its value (e.g. 'area sigma -2e-07 C/m^2')."""
+    {species number: name}) the rule and its value (e.g. 'area sigma -2e-07 C/m^2'); with
+    contact charging (tribo yes) the injected charges so, then 'charged by contacts'."""
+    label = _injected_charges(r, names)
+    if str(deck_vars(r).get("tribo", "no")) == "yes":
+        return f"injected {label}, charged by contacts"
+    return label
+
+
+def _injected_charges(r: dict, names: dict | None = None) -> str:
     v = deck_vars(r)
     try:
         if not is_charged(v):
