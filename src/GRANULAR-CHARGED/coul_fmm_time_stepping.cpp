@@ -48,7 +48,7 @@ void CoulFMMTimeStepping::Settings::validate() const
 
 CoulFMMTimeStepping::CoulFMMTimeStepping(const Settings &settings) :
     set(settings), interval(1), estimate(-1.0), slope_steps(0.0), last_check(0.0),
-    max_check(0.0), check_sums{0.0, 0.0}
+    max_check(0.0), check_sums{0.0, 0.0}, absorbing(false), absorb_tau(0.0), scale(0.0)
 {
   set.validate();
   if (set.tolerance > 0.0) set.every = 1 << (int) std::floor(std::log2((double) set.every));
@@ -206,6 +206,26 @@ void CoulFMMTimeStepping::displacements(const double xu[3], const double *state,
     delta[DELTA_B + k] = xu[k] - state[SLOPE_B + k];
   }
   delta[DELTA_IN_SLOPE] = state[IN_SLOPE];
+  delta[DELTA_Q] = state[Q];
+}
+
+/* ----------------------------------------------------------------------
+   doc/theory.md, eq. (5.6): a change dq at distance r >= rc makes a field C |dq| / r^2 <=
+   C |dq| / rc^2 at any atom (the pairs closer than rc are refreshed exactly); with x and y
+   periodic the images of the changes add, far from them, the sheet field of their net change
+------------------------------------------------------------------------- */
+
+double CoulFMMTimeStepping::absorbed_far_bound(double qqrd2e, double sum_abs_dq, double net_dq,
+                                               double rc, double area)
+{
+  double bound = std::fabs(qqrd2e) * sum_abs_dq / (rc * rc);
+  if (area > 0.0) bound += 2.0 * M_PI * std::fabs(qqrd2e) * std::fabs(net_dq) / area;
+  return bound;
+}
+
+void CoulFMMTimeStepping::set_field_scale(const double sums[2])
+{
+  scale = sums[1] > 0.0 ? std::sqrt(sums[0] / sums[1]) : 0.0;
 }
 
 void CoulFMMTimeStepping::add_error_sums(double q2, const double *applied, const double *reference,
