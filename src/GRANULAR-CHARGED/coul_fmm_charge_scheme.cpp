@@ -182,18 +182,19 @@ void CoulFMMChargeScheme::compute_field(bool with_slope, bool brought_forward)
       : MTS::Continuity::NONE;
   MTS::Plan plan = mts.plan(cont, with_slope, update->ntimestep);
   if (brought_forward) plan.ends_interval = false;
-  // the refresh the time stepping would have applied now, and D for a new slope
-  if (plan.near) {
+  // the refresh the time stepping would have applied now (only to measure the interval's
+  // error: not for an evaluation that does not end one), and D for a new slope
+  const bool near_now = plan.near && plan.ends_interval;
+  if (near_now)
     p.near->compute(mts, st, false, plan.keep_slope ? mts.trend_factor(plan.steps) : 0.0);
-    if (plan.new_slope) p.near->compute(mts, st, true, -1.0);
-  }
+  if (plan.near && plan.new_slope) p.near->compute(mts, st, true, -1.0);
   const int groupbit = p.fix->groupbit;
   for (int i = 0; i < nlocal; i++) {
     double xu[3];
     domain->unmap(atom->x[i], atom->image[i], xu);
     const double q = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
     mts.begin_evaluation(plan, st.evaluation(i), xu, q, eval->asleep(i),
-                         plan.near ? p.near->now()[i] : nullptr,
+                         near_now ? p.near->now()[i] : nullptr,
                          plan.near ? p.near->then()[i] : nullptr, st.field(i));
   }
   st.record(mts, eval->boundary());

@@ -276,8 +276,8 @@ CoulFMMTimeStepping::Continuity CoulFMMTimeStepping::continuity(const uint64_t s
 
 namespace {
 // the restart list starts with this marker (older files start with the step of the last
-// evaluation, >= -1, and hold no charge checksum)
-constexpr double kRestartFormat = -2.0;
+// evaluation, >= -1, and hold no charge checksum; files marked -2 hold no field scale)
+constexpr double kRestartFormat = -3.0, kRestartFormatNoScale = -2.0;
 enum : int {
   R_FORMAT,
   R_LAST,
@@ -290,6 +290,7 @@ enum : int {
   R_SUM_LO,
   R_QQRD2E,
   R_BOUNDARY,
+  R_SCALE,
   R_SIZE
 };
 static_assert(R_SIZE == CoulFMMTimeStepping::RESTART_SIZE, "restart list size");
@@ -309,12 +310,13 @@ void CoulFMMTimeStepping::write_restart(double list[RESTART_SIZE]) const
   list[R_SUM_LO] = (double) (evaluated.charges & 0xffffffffULL);
   list[R_QQRD2E] = evaluated.qqrd2e;
   list[R_BOUNDARY] = evaluated.boundary;
+  list[R_SCALE] = scale;
 }
 
 bool CoulFMMTimeStepping::read_restart(const double *list)
 {
   // a different every or tolerance gives a different schedule
-  if (list[R_FORMAT] != kRestartFormat) return false;
+  if (list[R_FORMAT] != kRestartFormat && list[R_FORMAT] != kRestartFormatNoScale) return false;
   if ((int) list[R_EVERY] != set.every || list[R_TOLERANCE] != set.tolerance) return false;
   interval = (int) list[R_STRIDE];
   slope_steps = list[R_SLOPE];
@@ -323,5 +325,7 @@ bool CoulFMMTimeStepping::read_restart(const double *list)
   evaluated.charges = ((uint64_t) list[R_SUM_HI] << 32) | (uint64_t) list[R_SUM_LO];
   evaluated.qqrd2e = list[R_QQRD2E];
   evaluated.boundary = (int) list[R_BOUNDARY];
+  // without it the first absorbed change forces an evaluation
+  scale = list[R_FORMAT] == kRestartFormat ? list[R_SCALE] : 0.0;
   return true;
 }

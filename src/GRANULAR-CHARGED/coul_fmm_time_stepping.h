@@ -248,8 +248,8 @@ class CoulFMMTimeStepping {
   const AbsorbCounts &absorbed_total() const { return total; }
   const AbsorbCounts &absorbed_this_run() const { return this_run; }
 
-  // ---- restart: the settings, schedule and Evaluated ----
-  static constexpr int RESTART_SIZE = 14;
+  // ---- restart: the settings, schedule, Evaluated and the field scale ----
+  static constexpr int RESTART_SIZE = 15;
   void write_restart(double list[RESTART_SIZE]) const;
   // false (nothing restored: evaluate afresh) for a file of an older format or of other settings
   bool read_restart(const double *list);

@@ -359,6 +359,15 @@ TEST(CoulFMMTimeStepping, AbsorbedFarBound)
   EXPECT_DOUBLE_EQ(m.field_scale(), std::sqrt(52.0 / 5.0));
   EXPECT_FALSE(m.far_part_exceeds(0.99e-3 * m.field_scale()));
   EXPECT_TRUE(m.far_part_exceeds(1.01e-3 * m.field_scale()));
+  // the scale is part of the restart list; a file of the format before it restores none
+  double list[MTS::RESTART_SIZE];
+  m.write_restart(list);
+  MTS r(settings(8, 1e-3, true, 4.0));
+  ASSERT_TRUE(r.read_restart(list));
+  EXPECT_EQ(r.field_scale(), m.field_scale());
+  list[0] = -2.0;
+  ASSERT_TRUE(r.read_restart(list));
+  EXPECT_EQ(r.field_scale(), 0.0);
   // no charge: scale 0, not a division by zero
   const double none[2] = {0.0, 0.0};
   m.set_field_scale(none);
