@@ -187,7 +187,8 @@ void CoulFMMChargeScheme::compute_field(bool with_slope, bool brought_forward)
   const bool near_now = plan.near && plan.ends_interval;
   if (near_now)
     p.near->compute(mts, st, false, plan.keep_slope ? mts.trend_factor(plan.steps) : 0.0);
-  if (plan.near && plan.new_slope) p.near->compute(mts, st, true, -1.0);
+  const bool near_then = plan.near && plan.new_slope;
+  if (near_then) p.near->compute(mts, st, true, -1.0);
   const int groupbit = p.fix->groupbit;
   for (int i = 0; i < nlocal; i++) {
     double xu[3];
@@ -195,7 +196,7 @@ void CoulFMMChargeScheme::compute_field(bool with_slope, bool brought_forward)
     const double q = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
     mts.begin_evaluation(plan, st.evaluation(i), xu, q, eval->asleep(i),
                          near_now ? p.near->now()[i] : nullptr,
-                         plan.near ? p.near->then()[i] : nullptr, st.field(i));
+                         near_then ? p.near->then()[i] : nullptr, st.field(i));
   }
   st.record(mts, eval->boundary());
   p.near->forget_pairs();    // the held pairs belong to the evaluation state overwritten above

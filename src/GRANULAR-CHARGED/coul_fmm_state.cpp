@@ -160,7 +160,7 @@ void CoulFMMState::record(CoulFMMTimeStepping &scheme, int boundary)
    deposit; or static sources woken) with all those of the evaluation still there and
    unchanged, or NONE. The sum of hashes is an integer sum (modulo 2^64): exact and the same
    however the atoms are distributed. When the scheme absorbs charge changes, an atom charged
-   at the evaluation and now (not a static source then) whose charge changed counts as
+   at the evaluation and now (not a static source then or now) whose charge changed counts as
    unchanged: the checksum is of the evaluation's charges, and its change is absorbed
    (doc/theory.md, eq. (5.5)); a charge that became 0 is a change (evaluated).
 ------------------------------------------------------------------------- */
@@ -175,8 +175,9 @@ CoulFMMTimeStepping::Continuity CoulFMMState::continuity(const CoulFMMTimeSteppi
   double dq[2] = {0.0, 0.0};
   for (int i = 0; i < atom->nlocal; i++) {
     const double q = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0, q_then = charge_then(i);
-    const bool absorbed =
-        absorb && q != q_then && q_then != 0.0 && q != 0.0 && !static_source_then(i);
+    // a static source (then or now) is not absorbed: its field is the static field's
+    const bool absorbed = absorb && q != q_then && q_then != 0.0 && q != 0.0 &&
+        !static_source_then(i) && !asleep_now(i);
     if (q_then != 0.0) sums[0] += coul_fmm_charge_hash(atom->tag[i], q_then);
     if (q != q_then && !absorbed) sums[1]++;
     if (q != q_then && q_then != 0.0 && !absorbed) sums[2]++;
