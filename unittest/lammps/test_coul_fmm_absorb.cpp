@@ -340,3 +340,14 @@ TEST(CoulFMMAbsorb, RestartContinuesTheAbsorbedChanges)
   EXPECT_LT(rel_rms(split, straight), 1e-14);
   EXPECT_LT(rel_rms(restarted, straight), 1e-10);
 }
+
+// a bad value of qchange is an error naming it
+TEST(CoulFMMAbsorb, BadValue)
+{
+  const std::string msg = gctest::error_of(
+      {"units real", "atom_style charge", "region box block 0 10 0 10 0 10", "create_box 1 box",
+       "fix fmm all coul/fmm every 8 near 5 qchange maybe"});
+  EXPECT_NE(msg.find("Fix coul/fmm qchange must be evaluate or absorb, got maybe"),
+            std::string::npos)
+      << msg;
+}
