@@ -45,8 +45,11 @@ class CoulFMMChargeScheme : public CoulFMMScheme, protected Pointers {
   Parts p;
   std::unique_ptr<CoulFMMEvaluator> eval;
   double nevaluations;
+  bool forced;                // this step's evaluation is forced by absorbed changes' far part
+  double pending_absorbed;    // charge changes of this step, absorbed if the field is continued
   void compute_field(bool with_slope, bool brought_forward = false);
   bool advance_field();
+  void init_absorbing();
   double apply_field();
 };
 

@@ -43,7 +43,7 @@ double near_pair_weight(int j, int nlocal)
 
 CoulFMMNearRefresh::CoulFMMNearRefresh(LAMMPS *lmp, Fix *owner) :
     Pointers(lmp), fix(owner), list(nullptr), delta(nullptr), near_now(nullptr), near_then(nullptr),
-    nmax_delta(0), nmax_out(0), pair_now{}, pair_then{}, pair_dg{}, pair_r2now(nullptr),
+    sending_charges(false), nmax_delta(0), nmax_out(0), pair_now{}, pair_then{}, pair_dg{}, pair_r2now(nullptr),
     pair_r2then(nullptr), simd_path(gcsimd::default_simd_path()), held_valid(false),
     leaving(false), near_pairs_evaluated(-1.0), pairs_lost(false), held_ncalls(-1), held_lastcall(-1), held_box{}
 {
@@ -116,6 +116,13 @@ void CoulFMMNearRefresh::exchange_displacements(const CoulFMMState &state)
   comm->forward_comm(fix);
 }
 
+void CoulFMMNearRefresh::share_charges()
+{
+  sending_charges = true;
+  comm->forward_comm(fix, 1);
+  sending_charges = false;
+}
+
 bool CoulFMMNearRefresh::charged(int i) const
 {
   return (atom->mask[i] & fix->groupbit) && atom->q[i] != 0.0;
@@ -184,10 +191,12 @@ void CoulFMMNearRefresh::compute_all(const MTS &scheme, double trend, double **o
 
   // each pair once: at i from j q_j dg, at j from i -q_i dg (field) and q_i dg (potential). A
   // ghost j is a local atom elsewhere (or an image here) whose own list holds the pair the
-  // other way round: only i is updated.
+  // other way round: only i is updated. Charges changed since the evaluation add their change
+  // at the separation then (CoulFMMTimeStepping::add_charge_change).
   p = 0;
   for (const auto &[i, end] : pair_i) {
     double e[4] = {0.0, 0.0, 0.0, 0.0};
+    const double dqi = q[i] - delta[i][MTS::DELTA_Q];
     for (; p < end; p++) {
       const int j = pair_j[p];
       const double now[3] = {pair_now[0][p], pair_now[1][p], pair_now[2][p]};
@@ -199,6 +208,14 @@ void CoulFMMNearRefresh::compute_all(const MTS &scheme, double trend, double **o
       if (j < nlocal) {
         for (int k = 0; k < 3; k++) out[j][k] -= q[i] * dg[k];
         out[j][3] += q[i] * dg[3];
+      }
+      const double dqj = q[j] - delta[j][MTS::DELTA_Q];
+      if (dqi != 0.0 || dqj != 0.0) {
+        gcfmm::FieldTerms<double> t;
+        gcfmm::charge_terms<false>(1.0, pair_then[0][p], pair_then[1][p], pair_then[2][p],
+                                   1.0 / std::sqrt(pair_r2then[p]), t);
+        const double then[4] = {t.ex, t.ey, t.ez, t.pot};
+        MTS::add_charge_change(dqi, dqj, then, e, j < nlocal ? out[j] : nullptr);
       }
     }
     for (int k = 0; k < 4; k++) out[i][k] += e[k];
@@ -254,6 +271,8 @@ void CoulFMMNearRefresh::hold_pairs(const MTS &scheme, const CoulFMMState &state
         if (r2then < cutsq) near_mine += near_pair_weight(j, atom->nlocal);
         HeldPair h;
         h.j = j;
+        h.qi_then = delta[i][MTS::DELTA_Q];
+        h.qj_then = delta[j][MTS::DELTA_Q];
         h.r2then = r2then;
         gcfmm::FieldTerms<double> t;
         gcfmm::charge_terms<false>(1.0, then[0], then[1], then[2], 1.0 / std::sqrt(r2then), t);
@@ -313,6 +332,8 @@ void CoulFMMNearRefresh::compute_held(const MTS &scheme, double trend, double **
         for (int k = 0; k < 3; k++) out[j][k] -= q[i] * dg[k];
         out[j][3] += q[i] * dg[3];
       }
+      MTS::add_charge_change(q[i] - h.qi_then, q[j] - h.qj_then, h.terms_then, e,
+                             j < nlocal ? out[j] : nullptr);
     }
     for (int k = 0; k < 4; k++) out[i][k] += e[k];
   }
@@ -337,6 +358,10 @@ void CoulFMMNearRefresh::grow_pairs(int n)
 int CoulFMMNearRefresh::pack(int n, int *list_send, double *buf) const
 {
   int m = 0;
+  if (sending_charges) {
+    for (int i = 0; i < n; i++) buf[m++] = atom->q[list_send[i]];
+    return m;
+  }
   for (int i = 0; i < n; i++)
     for (int k = 0; k < MTS::DELTA_COLS; k++) buf[m++] = delta[list_send[i]][k];
   return m;
@@ -345,6 +370,10 @@ int CoulFMMNearRefresh::pack(int n, int *list_send, double *buf) const
 void CoulFMMNearRefresh::unpack(int n, int first, const double *buf)
 {
   int m = 0;
+  if (sending_charges) {
+    for (int i = first; i < first + n; i++) atom->q[i] = buf[m++];
+    return;
+  }
   for (int i = first; i < first + n; i++)
     for (int k = 0; k < MTS::DELTA_COLS; k++) delta[i][k] = buf[m++];
 }

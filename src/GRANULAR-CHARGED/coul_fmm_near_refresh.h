@@ -57,7 +57,12 @@ class CoulFMMNearRefresh : protected Pointers {
   double **now() const { return near_now; }
   double **then() const { return near_then; }
 
-  // the owner fix's forward communication of the displacements
+  // the local atoms' charges to their ghosts: a style that changes charges within a run may
+  // change the local atoms' only, and the refresh sums the ghosts' charges (called on the steps
+  // on which a charge changed)
+  void share_charges();
+
+  // the owner fix's forward communication of the displacements (or of the charges)
   int pack(int n, int *list_send, double *buf) const;
   void unpack(int n, int first, const double *buf);
   double memory_usage() const;
@@ -66,6 +71,7 @@ class CoulFMMNearRefresh : protected Pointers {
   class Fix *fix;
   class NeighList *list;
   double **delta, **near_now, **near_then;
+  bool sending_charges;    // forward communication: the charges (share_charges), not delta
   int nmax_delta, nmax_out;
   // the pairs of one compute() as arrays (gcfmm::charge_pair_change): separations now and at
   // the evaluation, the kernel differences and the squared separations, in pair_buffer
@@ -90,6 +96,7 @@ class CoulFMMNearRefresh : protected Pointers {
   // only the separation now is computed, without the displacements or their communication.
   struct HeldPair {
     int j;
+    double qi_then, qj_then;       // the two charges at the evaluation (absorbed changes)
     double r2then;                 // squared separation at the evaluation
     double terms_then[4];          // (K, 1/r) at the evaluation
     double slope_change[4];        // CoulFMMTimeStepping::slope_pair_change

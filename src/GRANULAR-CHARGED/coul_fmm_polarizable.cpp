@@ -86,6 +86,11 @@ void CoulFMMPolarizable::check_combinations()
                  "Fix coul/fmm polarize with fix efield: fix efield's field would not "
                  "polarize the particles; give it to fix coul/fmm efield instead");
   }
+  if (parts.qchange == QChange::ABSORB && comm->me == 0)
+    error->warning(FLERR,
+                   "Fix coul/fmm {}: qchange absorb has no effect with efield, polarize or "
+                   "electrode (a changed charge is evaluated)",
+                   parts.fix->id);
   if (parts.stepping->settings().check_every > 0 && comm->me == 0)
     error->warning(FLERR,
                    "Fix coul/fmm {}: check is ignored with efield, polarize or electrode (the "

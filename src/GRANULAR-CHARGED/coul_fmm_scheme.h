@@ -36,6 +36,10 @@ class Fix;
 
 class CoulFMMScheme {
  public:
+  // keyword qchange: evaluate the field when a charge changes, absorb the change (doc/theory.md,
+  // eq. (5.5)), or absorb when a fix declares charge transfers (the default)
+  enum class QChange { AUTO, EVALUATE, ABSORB };
+
   // the fix's parts a scheme works with (kept by the fix)
   struct Parts {
     Fix *fix;
@@ -46,6 +50,7 @@ class CoulFMMScheme {
     CoulFMMNearRefresh *near;
     bool sleepers_static;    // keyword sleepers static
     bool distributed;        // keyword solver distributed
+    QChange qchange;         // keyword qchange
   };
 
   // the solver's side of the last evaluation (the same on every rank): vector elements 1-4,

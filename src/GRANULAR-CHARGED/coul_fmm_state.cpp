@@ -99,10 +99,24 @@ void CoulFMMState::apply_evaluated(int i)
   for (int k = 0; k < 4; k++) applied[i][k] = row[i][MTS::FIELD + k];
 }
 
-void CoulFMMState::remember_positions()
+void CoulFMMState::remember_applied()
 {
-  for (int i = 0; i < atom->nlocal; i++)
+  for (int i = 0; i < atom->nlocal; i++) {
     domain->unmap(atom->x[i], atom->image[i], &row[i][MTS::LAST_X]);
+    row[i][MTS::LAST_Q] = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
+  }
+}
+
+void CoulFMMState::field_scale_sums(double sums[2])
+{
+  sums[0] = sums[1] = 0.0;
+  for (int i = 0; i < atom->nlocal; i++) {
+    const double q = charge_then(i), *e = &row[i][MTS::FIELD];
+    if (q == 0.0 || static_source_then(i)) continue;
+    sums[0] += q * q * (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    sums[1] += q * q;
+  }
+  mpi.sum(sums, 2);
 }
 
 // one pass over the local charges; error->one, as the atom is on this rank only
@@ -145,26 +159,49 @@ void CoulFMMState::record(CoulFMMTimeStepping &scheme, int boundary)
    SAME charges (same IDs, same values) in the same geometry and units, charges ADDED (fix
    deposit; or static sources woken) with all those of the evaluation still there and
    unchanged, or NONE. The sum of hashes is an integer sum (modulo 2^64): exact and the same
-   however the atoms are distributed.
+   however the atoms are distributed. When the scheme absorbs charge changes, an atom charged
+   at the evaluation and now (not a static source then or now) whose charge changed counts as
+   unchanged: the checksum is of the evaluation's charges, and its change is absorbed
+   (doc/theory.md, eq. (5.5)); a charge that became 0 is a change (evaluated).
 ------------------------------------------------------------------------- */
 
 CoulFMMTimeStepping::Continuity CoulFMMState::continuity(const CoulFMMTimeStepping &scheme,
                                                          int boundary, const Predicate &asleep_now)
 {
+  const bool absorb = scheme.absorbs();
+  // [0]-[3] as CoulFMMTimeStepping::continuity() reads them; [4] changed since applied, [5]
+  // absorbing, [6] absorbing and changed since applied
+  uint64_t sums[7] = {0, 0, 0, 0, 0, 0, 0};
+  double dq[2] = {0.0, 0.0};
+  for (int i = 0; i < atom->nlocal; i++) {
+    const double q = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0, q_then = charge_then(i);
+    // a static source (then or now) is not absorbed: its field is the static field's
+    const bool absorbed = absorb && q != q_then && q_then != 0.0 && q != 0.0 &&
+        !static_source_then(i) && !asleep_now(i);
+    if (q_then != 0.0) sums[0] += coul_fmm_charge_hash(atom->tag[i], q_then);
+    if (q != q_then && !absorbed) sums[1]++;
+    if (q != q_then && q_then != 0.0 && !absorbed) sums[2]++;
+    if (q != 0.0 && static_source_then(i) && !asleep_now(i)) sums[3]++;
+    const bool changed = q != row[i][MTS::LAST_Q];
+    if (changed) sums[4]++;
+    if (absorbed) {
+      sums[5]++;
+      if (changed) sums[6]++;
+      dq[0] += std::fabs(q - q_then);
+      dq[1] += q - q_then;
+    }
+  }
+  mpi.sum(sums, 7);
+  if (absorb) mpi.sum(dq, 2);
+  changes.since_applied = (double) sums[4];
+  changes.absorbed = (double) sums[5];
+  changes.absorbed_now = (double) sums[6];
+  changes.sum_abs_dq = dq[0];
+  changes.net_dq = dq[1];
   double box[4];
   cell(box);
   const bool periodic = boundary == static_cast<int>(gcfmm::Boundary::Periodic2D);
-  if (!scheme.same_setting(boundary, force->qqrd2e, box, periodic))
-    return MTS::Continuity::NONE;
-  uint64_t sums[4] = {0, 0, 0, 0};    // as CoulFMMTimeStepping::continuity() reads them
-  for (int i = 0; i < atom->nlocal; i++) {
-    const double q = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0, q_then = charge_then(i);
-    if (q_then != 0.0) sums[0] += coul_fmm_charge_hash(atom->tag[i], q_then);
-    if (q != q_then) sums[1]++;
-    if (q != q_then && q_then != 0.0) sums[2]++;
-    if (q != 0.0 && static_source_then(i) && !asleep_now(i)) sums[3]++;
-  }
-  mpi.sum(sums, 4);
+  if (!scheme.same_setting(boundary, force->qqrd2e, box, periodic)) return MTS::Continuity::NONE;
   return scheme.continuity(sums);
 }
 

@@ -59,8 +59,9 @@ class CoulFMMState : protected Pointers {
   const double *position_applied(int i) const { return &row[i][MTS::LAST_X]; }
   // the evaluated field becomes the applied one (the atoms' first field columns)
   void apply_evaluated(int i);
-  // where the local atoms are now: a later run continues the stored field only from there
-  void remember_positions();
+  // where the local atoms are and their charges when a field was applied: a later run continues
+  // the stored field only from those positions, and the next step counts the charges changed
+  void remember_applied();
   // before an evaluation: every charge of the group is finite, else an error naming the atom
   // (a NaN or inf charge would make every field and force NaN)
   void check_charges(const char *fix_id) const;
@@ -70,9 +71,21 @@ class CoulFMMState : protected Pointers {
   using Predicate = std::function<bool(int)>;
   // before an evaluation: the charges, step, Coulomb constant, boundary and cell it is of
   void record(CoulFMMTimeStepping &scheme, int boundary);
-  // how the stored evaluation relates to the atoms now
+  // how the stored evaluation relates to the atoms now; also takes charge_changes()
   CoulFMMTimeStepping::Continuity continuity(const CoulFMMTimeStepping &scheme, int boundary,
                                              const Predicate &asleep_now);
+  // the charges found by the last continuity(), summed over the ranks
+  struct ChargeChanges {
+    double since_applied = 0.0;    // atoms whose charge changed since a field was last applied
+    double absorbed = 0.0;         // atoms absorbing a change (CoulFMMTimeStepping::absorbs)
+    double absorbed_now = 0.0;     // of those, the ones whose charge changed since last applied
+    double sum_abs_dq = 0.0;       // sum |q - q_then| over the absorbing atoms
+    double net_dq = 0.0;           // sum (q - q_then) over them
+  };
+  const ChargeChanges &charge_changes() const { return changes; }
+  // sum q^2 |E|^2 and sum q^2 over the charged atoms of the evaluation (not static sources),
+  // all ranks: the field scale of CoulFMMTimeStepping::set_field_scale
+  void field_scale_sums(double sums[2]);
   // at the start of a run: continuity(), and NONE also when an atom of the evaluation was moved
   // since the field was last applied (displace_atoms, set)
   CoulFMMTimeStepping::Continuity continuation(const CoulFMMTimeStepping &scheme, int boundary,
@@ -83,6 +96,7 @@ class CoulFMMState : protected Pointers {
   int groupbit;
   double **applied, **applied_force, **row;
   CoulFMMComm mpi;
+  ChargeChanges changes;
   void cell(double box[4]) const;
 };
 

@@ -48,7 +48,7 @@ void CoulFMMTimeStepping::Settings::validate() const
 
 CoulFMMTimeStepping::CoulFMMTimeStepping(const Settings &settings) :
     set(settings), interval(1), estimate(-1.0), slope_steps(0.0), last_check(0.0),
-    max_check(0.0), check_sums{0.0, 0.0}
+    max_check(0.0), check_sums{0.0, 0.0}, absorbing(false), absorb_tau(0.0), scale(0.0)
 {
   set.validate();
   if (set.tolerance > 0.0) set.every = 1 << (int) std::floor(std::log2((double) set.every));
@@ -206,6 +206,26 @@ void CoulFMMTimeStepping::displacements(const double xu[3], const double *state,
     delta[DELTA_B + k] = xu[k] - state[SLOPE_B + k];
   }
   delta[DELTA_IN_SLOPE] = state[IN_SLOPE];
+  delta[DELTA_Q] = state[Q];
+}
+
+/* ----------------------------------------------------------------------
+   doc/theory.md, eq. (5.6): a change dq at distance r >= rc makes a field C |dq| / r^2 <=
+   C |dq| / rc^2 at any atom (the pairs closer than rc are refreshed exactly); with x and y
+   periodic the images of the changes add, far from them, the sheet field of their net change
+------------------------------------------------------------------------- */
+
+double CoulFMMTimeStepping::absorbed_far_bound(double qqrd2e, double sum_abs_dq, double net_dq,
+                                               double rc, double area)
+{
+  double bound = std::fabs(qqrd2e) * sum_abs_dq / (rc * rc);
+  if (area > 0.0) bound += 2.0 * M_PI * std::fabs(qqrd2e) * std::fabs(net_dq) / area;
+  return bound;
+}
+
+void CoulFMMTimeStepping::set_field_scale(const double sums[2])
+{
+  scale = sums[1] > 0.0 ? std::sqrt(sums[0] / sums[1]) : 0.0;
 }
 
 void CoulFMMTimeStepping::add_error_sums(double q2, const double *applied, const double *reference,
@@ -256,8 +276,8 @@ CoulFMMTimeStepping::Continuity CoulFMMTimeStepping::continuity(const uint64_t s
 
 namespace {
 // the restart list starts with this marker (older files start with the step of the last
-// evaluation, >= -1, and hold no charge checksum)
-constexpr double kRestartFormat = -2.0;
+// evaluation, >= -1, and hold no charge checksum; files marked -2 hold no field scale)
+constexpr double kRestartFormat = -3.0, kRestartFormatNoScale = -2.0;
 enum : int {
   R_FORMAT,
   R_LAST,
@@ -270,6 +290,7 @@ enum : int {
   R_SUM_LO,
   R_QQRD2E,
   R_BOUNDARY,
+  R_SCALE,
   R_SIZE
 };
 static_assert(R_SIZE == CoulFMMTimeStepping::RESTART_SIZE, "restart list size");
@@ -289,12 +310,13 @@ void CoulFMMTimeStepping::write_restart(double list[RESTART_SIZE]) const
   list[R_SUM_LO] = (double) (evaluated.charges & 0xffffffffULL);
   list[R_QQRD2E] = evaluated.qqrd2e;
   list[R_BOUNDARY] = evaluated.boundary;
+  list[R_SCALE] = scale;
 }
 
 bool CoulFMMTimeStepping::read_restart(const double *list)
 {
   // a different every or tolerance gives a different schedule
-  if (list[R_FORMAT] != kRestartFormat) return false;
+  if (list[R_FORMAT] != kRestartFormat && list[R_FORMAT] != kRestartFormatNoScale) return false;
   if ((int) list[R_EVERY] != set.every || list[R_TOLERANCE] != set.tolerance) return false;
   interval = (int) list[R_STRIDE];
   slope_steps = list[R_SLOPE];
@@ -303,5 +325,7 @@ bool CoulFMMTimeStepping::read_restart(const double *list)
   evaluated.charges = ((uint64_t) list[R_SUM_HI] << 32) | (uint64_t) list[R_SUM_LO];
   evaluated.qqrd2e = list[R_QQRD2E];
   evaluated.boundary = (int) list[R_BOUNDARY];
+  // without it the first absorbed change forces an evaluation
+  scale = list[R_FORMAT] == kRestartFormat ? list[R_SCALE] : 0.0;
   return true;
 }

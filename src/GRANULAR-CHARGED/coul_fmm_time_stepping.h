@@ -35,14 +35,23 @@ class CoulFMMTimeStepping {
     SLOPE_B = 18,    // (3 each): the trend of a pair inside the slope, for the near refresh
     IN_SLOPE = 21,   // 1 if the slope covers this atom's pairs (it existed at both evaluations)
     ASLEEP = 22,     // 1 if the atom was a static source (fix sleep/gran) at the evaluation
-    COLS = 23
+    LAST_Q = 23,     // charge when a field was last applied (0 outside the group)
+    COLS = 24
   };
   // rows of restart files written before ASLEEP existed
   static constexpr int COLS_V1 = 22;
 
   // one atom's displacements for the near refresh (local atoms and ghosts): since the
-  // evaluation, since the two evaluations of the slope, and whether the slope covers it
-  enum Delta : int { DELTA_E = 0, DELTA_A = 3, DELTA_B = 6, DELTA_IN_SLOPE = 9, DELTA_COLS = 10 };
+  // evaluation, since the two evaluations of the slope, whether the slope covers it, and its
+  // charge at the evaluation (the change of an absorbed charge, eq. (5.5))
+  enum Delta : int {
+    DELTA_E = 0,
+    DELTA_A = 3,
+    DELTA_B = 6,
+    DELTA_IN_SLOPE = 9,
+    DELTA_Q = 10,
+    DELTA_COLS = 11
+  };
 
   // the keywords of the scheme, checked once by validate()
   struct Settings {
@@ -184,8 +193,63 @@ class CoulFMMTimeStepping {
   // were static sources then and are awake now (no stored field, like added ones)
   Continuity continuity(const uint64_t sums[4]) const;
 
-  // ---- restart: the settings, schedule and Evaluated ----
-  static constexpr int RESTART_SIZE = 14;
+  // ---- charge changes absorbed between evaluations (doc/theory.md, eq. (5.5)) ----
+  // on: an atom charged at the evaluation whose charge changed since is no reason to evaluate;
+  // the change is a point charge dq = q - q_then at the atom, exact for the refreshed pairs and
+  // left out beyond them while absorbed_far_bound stays below tau times the field scale
+  void set_absorbing(bool on, double tau)
+  {
+    absorbing = on;
+    absorb_tau = tau;
+  }
+  bool absorbs() const { return absorbing; }
+  // what the charge changes add to a refreshed pair ij: at i the field and potential of dq_j at
+  // the separation of the evaluation, dq_j (K, 1/r)(r_then); at j (at_j non-null: a local atom)
+  // those of dq_i, -dq_i K(r_then) and dq_i / |r_then|. So the pair's refreshed term is
+  // q_j(now) (K, 1/r)(r_now) - q_j(then) (K, 1/r)(r_then) with the q_j(now) part of dg.
+  static void add_charge_change(double dq_i, double dq_j, const double terms_then[4],
+                                double at_i[4], double *at_j)
+  {
+    if (dq_j != 0.0)
+      for (int k = 0; k < 4; k++) at_i[k] += dq_j * terms_then[k];
+    if (at_j && dq_i != 0.0) {
+      for (int k = 0; k < 3; k++) at_j[k] -= dq_i * terms_then[k];
+      at_j[3] += dq_i * terms_then[3];
+    }
+  }
+  // an upper bound of the field, at any atom, of the changes beyond the near cutoff rc (which
+  // the refresh leaves out): C sum_i |dq_i| / rc^2 for the cell's copy of the changes, plus
+  // with x and y periodic (area = Lx Ly > 0) the sheet field 2 pi C |sum_i dq_i| / area of
+  // their net change
+  static double absorbed_far_bound(double qqrd2e, double sum_abs_dq, double net_dq, double rc,
+                                   double area);
+  // the field scale of the last evaluation, sqrt(sum q^2 |E|^2 / sum q^2), from those two sums
+  void set_field_scale(const double sums[2]);
+  double field_scale() const { return scale; }
+  // the far part of the absorbed changes is too large: evaluate (a zero field scale, e.g. after
+  // a restart or with a single charge, always is)
+  bool far_part_exceeds(double bound) const { return bound > absorb_tau * scale; }
+  // counts: charge changes absorbed (atoms whose charge changed on a step continued without
+  // evaluation) and evaluations forced by the bound, since the fix was defined and in this run
+  struct AbsorbCounts {
+    double changes = 0.0, forced = 0.0;
+  };
+  void count_absorbed(double changes)
+  {
+    total.changes += changes;
+    this_run.changes += changes;
+  }
+  void count_forced()
+  {
+    total.forced += 1.0;
+    this_run.forced += 1.0;
+  }
+  void start_run_counts() { this_run = AbsorbCounts(); }
+  const AbsorbCounts &absorbed_total() const { return total; }
+  const AbsorbCounts &absorbed_this_run() const { return this_run; }
+
+  // ---- restart: the settings, schedule, Evaluated and the field scale ----
+  static constexpr int RESTART_SIZE = 15;
   void write_restart(double list[RESTART_SIZE]) const;
   // false (nothing restored: evaluate afresh) for a file of an older format or of other settings
   bool read_restart(const double *list);
@@ -196,6 +260,10 @@ class CoulFMMTimeStepping {
   double estimate;       // error measured at the last evaluation that continued a field
   double slope_steps;    // steps between the two evaluations of the slope
   double last_check, max_check, check_sums[2];
+  bool absorbing;        // charge changes absorbed (set_absorbing)
+  double absorb_tau;     // the far part's allowance relative to the field scale
+  double scale;          // field scale of the last evaluation (0: unknown)
+  AbsorbCounts total, this_run;
 };
 
 // hash of one charged atom (ID, charge bits) for the checksum of the charges: summed modulo

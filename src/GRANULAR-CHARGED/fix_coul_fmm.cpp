@@ -39,13 +39,14 @@ using MTS = CoulFMMTimeStepping;
 FixCoulFMM::FixCoulFMM(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), opts(new gcfmm::Options), backend(new CoulFMMBackend(lmp)),
     near(new CoulFMMNearRefresh(lmp, this)), field_cols(4), bed_given(false),
-    sleepers_static(true), distributed(false), energy_local(0.0), energy_all(0.0),
+    sleepers_static(true), distributed(false), qchange(CoulFMMScheme::QChange::AUTO),
+    energy_local(0.0), energy_all(0.0),
     energy_summed(false), ilevel_respa(0)
 {
   scalar_flag = 1;
   extscalar = 1;
   vector_flag = 1;    // diagnostics: solver (error estimate, order, M2L, P2P), MTS check, schedule
-  size_vector = 14;
+  size_vector = 16;
   extvector = 0;
   global_freq = 1;
   energy_global_flag = 1;
@@ -114,6 +115,7 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
     const std::string key = arg[iarg];
     const bool known = reals.count(key) || integers.count(key) || key == "farfield" ||
         key == "bed" || key == "extrapolate" || key == "sleepers" || key == "solver" ||
+        key == "qchange" ||
         key == "efield" || key == "polarize" || key == "electrode" || key == "induction";
     if (!known) error->all(FLERR, iarg, "Unknown fix coul/fmm keyword: {}", key);
     // values of the keyword: polarize takes eps_p and an optional eps_m
@@ -135,6 +137,9 @@ void FixCoulFMM::parse_keywords(int narg, char **arg)
       sleepers_static = one_of(iarg, {"static", "full"}, arg) == 0;
     } else if (key == "solver") {
       distributed = one_of(iarg, {"distributed", "replicated"}, arg) == 0;
+    } else if (key == "qchange") {
+      qchange = one_of(iarg, {"evaluate", "absorb"}, arg) == 0 ? CoulFMMScheme::QChange::EVALUATE
+                                                               : CoulFMMScheme::QChange::ABSORB;
     } else if (key == "bed") {
       opts->bed_zlo = utils::numeric(FLERR, v, false, lmp);
       opts->bed_zhi = utils::numeric(FLERR, arg[iarg + 2], false, lmp);
@@ -175,7 +180,7 @@ void FixCoulFMM::create_parts(const MTS::Settings &mts)
 CoulFMMScheme::Parts FixCoulFMM::parts()
 {
   return {this, opts.get(), stepping.get(), state.get(), backend.get(), near.get(),
-          sleepers_static, distributed};
+          sleepers_static, distributed, qchange};
 }
 
 // the position of keyword arg[iarg]'s value among `words`, or an error listing them
@@ -306,6 +311,19 @@ void FixCoulFMM::min_setup(int vflag)
   min_post_force(vflag);
 }
 
+// the charge changes absorbed in this run (doc/fix_coul_fmm.rst, "Output"), when there were
+// any; counted from the end of the last run (a run with pre no has no setup)
+void FixCoulFMM::post_run()
+{
+  const auto &run = stepping->absorbed_this_run();
+  if (run.changes > 0.0 && comm->me == 0)
+    utils::logmesg(lmp,
+                   "Fix coul/fmm {}: absorbed {:.0f} charge changes; {:.0f} evaluations forced "
+                   "by their far part\n",
+                   id, run.changes, run.forced);
+  stepping->start_run_counts();
+}
+
 // a line search evaluates several trial positions within one step: no prediction
 void FixCoulFMM::min_post_force(int vflag)
 {
@@ -340,7 +358,7 @@ void FixCoulFMM::apply(int vflag, bool predict)
                    in_plane ? fi[2] * x[i][1] : 0.0};
     v_tally(i, v);
   }
-  state->remember_positions();
+  state->remember_applied();
 }
 
 // with static sleepers, plus their pair energy with the awake charges and among themselves
@@ -358,11 +376,13 @@ double FixCoulFMM::compute_scalar()
 // check (last, largest, all checks), 8 interval, 9 the MTS error at the last evaluation that
 // continued a field, 10 evaluations, 11 bytes received by the busiest rank in the last
 // evaluation, 12 the largest solver memory of a rank (bytes), 13-14 the induced dipoles
-// iterations and residual at the last evaluation (polarize)
+// iterations and residual at the last evaluation (polarize), 15 the charge changes absorbed and
+// 16 the evaluations their far part forced, since the fix was defined
 double FixCoulFMM::compute_vector(int n)
 {
   const auto &d = scheme->diagnostics();
-  const double values[14] = {d.estimated_error,
+  const auto &absorbed = stepping->absorbed_total();
+  const double values[16] = {d.estimated_error,
                              (double) d.order,
                              d.m2l,
                              d.p2p,
@@ -375,8 +395,10 @@ double FixCoulFMM::compute_vector(int n)
                              d.bytes_received,
                              d.solver_memory,
                              (double) d.iterations,
-                             d.residual};
-  return n >= 0 && n < 14 ? values[n] : 0.0;
+                             d.residual,
+                             absorbed.changes,
+                             absorbed.forced};
+  return n >= 0 && n < 16 ? values[n] : 0.0;
 }
 
 double FixCoulFMM::memory_usage()

@@ -46,6 +46,7 @@ class FixCoulFMM : public Fix {
   void post_force(int) override;
   void post_force_respa(int, int, int) override;
   void min_post_force(int) override;
+  void post_run() override;
   double compute_scalar() override;
   double compute_vector(int) override;
   double memory_usage() override;
@@ -76,6 +77,7 @@ class FixCoulFMM : public Fix {
   std::string periodic_keyword;    // last of images/farfield given (ignored in free space)
   bool sleepers_static;            // keyword sleepers: static (true) or full
   bool distributed;                // keyword solver: distributed (true) or replicated
+  CoulFMMScheme::QChange qchange;  // keyword qchange
 
   double energy_local, energy_all;
   bool energy_summed;

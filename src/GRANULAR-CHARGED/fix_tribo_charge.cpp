@@ -65,7 +65,7 @@ FixTriboCharge::FixTriboCharge(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), z0(0.0), field_on(true), maxcontacts(16), rowsize(0), transfers_flag(1),
     list(nullptr), coul(nullptr), quantum(0.0), coulomb(0.0), eps(0.0), row(nullptr),
     ghost(nullptr), nmax_ghost(0), comm_stage(0), moved_pair(0.0), given_wall(0.0),
-    events_pair(0.0), events_wall(0.0)
+    events_pair(0.0), events_wall(0.0), cached_key{-1.0, -1.0, -1.0}
 {
   if (!atom->q_flag || !atom->radius_flag)
     error->all(FLERR, "Fix {} requires atom attributes q and radius (e.g. atom_style hybrid sphere charge)", style);
@@ -316,6 +316,19 @@ void FixTriboCharge::sweep_records(int i, bigint step)
   r[NREC] = kept;
 }
 
+// the JKR scales of (R_eff, gamma, E*): most contacts of a powder share them, so the last one is
+// kept (two cube roots otherwise per contact and step)
+const MarshallKernels::JKRScales &FixTriboCharge::scales_of(double reff, double gamma_, double emix_)
+{
+  if (reff != cached_key[0] || gamma_ != cached_key[1] || emix_ != cached_key[2]) {
+    cached_key[0] = reff;
+    cached_key[1] = gamma_;
+    cached_key[2] = emix_;
+    cached_scales = MK::jkr_scales(reff, gamma_, emix_);
+  }
+  return cached_scales;
+}
+
 const double *FixTriboCharge::field_of(int i) const
 {
   return &ghost[i][6];
@@ -413,7 +426,7 @@ void FixTriboCharge::charge_pair(int i, int j, bigint step, std::vector<int> &ch
   const double reff = MK::effective_radius(ra, rb);
   const bool maybe = rsq < radsum * radsum;
   if (!maybe && !was) return;
-  const MK::JKRScales sc = MK::jkr_scales(reff, ga, em);
+  const MK::JKRScales &sc = scales_of(reff, ga, em);
   if (!MK::jkr_touch(was, rsq, radsum, sc.deltac)) return;    // unseen: swept as ended
 
   if (!rec_i) rec_i = add_record(i, (double) tag[j]);
@@ -422,7 +435,8 @@ void FixTriboCharge::charge_pair(int i, int j, bigint step, std::vector<int> &ch
   if (rec_j) rec_j[2] = (double) step;
 
   const double r = std::sqrt(rsq);
-  const double area = MathConst::MY_PI * std::pow(MK::jkr_normal_force(sc, ga, em, radsum - r, reff).a, 2);
+  const double a_contact = MK::jkr_normal_force(sc, ga, em, radsum - r, reff).a;
+  const double area = MathConst::MY_PI * a_contact * a_contact;
   if (!(area > rec_i[1])) return;
   const double darea = area - rec_i[1];
   rec_i[1] = area;
@@ -482,12 +496,12 @@ void FixTriboCharge::charge_walls(bigint step, std::vector<int> &changed)
         const double rad = radius[i];
         const bool was = rec != nullptr;
         if (!was && dist >= rad) continue;
-        const MK::JKRScales sc = MK::jkr_scales(rad, wall.gamma, wall.emix);
+        const MK::JKRScales &sc = scales_of(rad, wall.gamma, wall.emix);
         if (!MK::jkr_touch(was, dist * dist, rad, sc.deltac)) continue;
         if (!rec) rec = add_record(i, key);
         rec[2] = (double) step;
-        const double area =
-            MathConst::MY_PI * std::pow(MK::jkr_normal_force(sc, wall.gamma, wall.emix, rad - dist, rad).a, 2);
+        const double a_contact = MK::jkr_normal_force(sc, wall.gamma, wall.emix, rad - dist, rad).a;
+        const double area = MathConst::MY_PI * a_contact * a_contact;
         if (!(area > rec[1])) continue;
         const double darea = area - rec[1];
         rec[1] = area;

@@ -18,6 +18,8 @@ FixStyle(tribo/charge,FixTriboCharge);
 
 #include "fix.h"
 
+#include "marshall_kernels.h"
+
 #include <string>
 #include <utility>
 #include <vector>
@@ -113,6 +115,9 @@ class FixTriboCharge : public Fix {
   void charge_pair(int i, int j, bigint step, std::vector<int> &changed);
   void charge_walls(bigint step, std::vector<int> &changed);
   const double *field_of(int i) const;
+  double cached_key[3];    // R_eff, gamma, E* of cached_scales
+  MarshallKernels::JKRScales cached_scales;
+  const MarshallKernels::JKRScales &scales_of(double reff, double gamma_, double emix_);
 };
 
 }    // namespace LAMMPS_NS

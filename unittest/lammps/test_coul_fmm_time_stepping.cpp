@@ -310,3 +310,75 @@ TEST(CoulFMMTimeStepping, RestartListRoundTrip)
   list[0] = 5.0;    // an older file starts with the step
   EXPECT_FALSE(r.read_restart(list));
 }
+
+// eq. (5.5): a refreshed pair whose charges changed sums q(now) (K, 1/r)(r_now) - q(then)
+// (K, 1/r)(r_then) at both atoms: the near-pair change times the charges now plus the charge
+// change at the separation then, against the kernel evaluated directly (1e-14: a few ulps of
+// terms of order 1)
+TEST(CoulFMMTimeStepping, ChangedChargesOfAPairAtTheSeparationThen)
+{
+  const double now[3] = {0.9, -0.4, 0.3}, then[3] = {0.6, -0.5, 0.45};
+  const double qi_then = 0.7, qj_then = -1.1, qi = 0.75, qj = -1.3;
+  double gn[4], gt[4];
+  kernel(now, gn);
+  kernel(then, gt);
+  double at_i[4], at_j[4];
+  for (int k = 0; k < 4; k++) {
+    at_i[k] = qj * (gn[k] - gt[k]);
+    at_j[k] = (k < 3 ? -1.0 : 1.0) * qi * (gn[k] - gt[k]);    // K(-r) = -K(r), 1/r even
+  }
+  MTS::add_charge_change(qi - qi_then, qj - qj_then, gt, at_i, at_j);
+  for (int k = 0; k < 4; k++) {
+    const double sign = k < 3 ? -1.0 : 1.0;
+    EXPECT_NEAR(at_i[k], qj * gn[k] - qj_then * gt[k], 1e-14);
+    EXPECT_NEAR(at_j[k], sign * (qi * gn[k] - qi_then * gt[k]), 1e-14);
+  }
+  // unchanged charges add nothing, bit for bit; a ghost j (at_j null) gets nothing
+  double same[4] = {1.0, 2.0, 3.0, 4.0};
+  MTS::add_charge_change(0.0, 0.0, gt, same, nullptr);
+  EXPECT_EQ(same[0], 1.0);
+  EXPECT_EQ(same[3], 4.0);
+}
+
+// eq. (5.6): the bound of the changes' field beyond the near cutoff, and the rule that forces
+// an evaluation against tau times the field scale of the last evaluation
+TEST(CoulFMMTimeStepping, AbsorbedFarBound)
+{
+  // C sum |dq| / rc^2, plus 2 pi C |sum dq| / (Lx Ly) with x and y periodic
+  EXPECT_DOUBLE_EQ(MTS::absorbed_far_bound(2.0, 0.3, 0.1, 4.0, 0.0), 2.0 * 0.3 / 16.0);
+  EXPECT_DOUBLE_EQ(MTS::absorbed_far_bound(2.0, 0.3, -0.1, 4.0, 50.0),
+                   2.0 * 0.3 / 16.0 + 2.0 * M_PI * 2.0 * 0.1 / 50.0);
+  MTS m(settings(8, 1e-3, true, 4.0));
+  m.set_absorbing(true, 1e-3);
+  EXPECT_TRUE(m.absorbs());
+  // unknown scale (no evaluation yet): any change forces an evaluation
+  EXPECT_TRUE(m.far_part_exceeds(1e-30));
+  // two charges 2 and 1 with fields 3 and 4: sqrt((4*9 + 1*16) / 5)
+  const double sums[2] = {4.0 * 9.0 + 16.0, 5.0};
+  m.set_field_scale(sums);
+  EXPECT_DOUBLE_EQ(m.field_scale(), std::sqrt(52.0 / 5.0));
+  EXPECT_FALSE(m.far_part_exceeds(0.99e-3 * m.field_scale()));
+  EXPECT_TRUE(m.far_part_exceeds(1.01e-3 * m.field_scale()));
+  // the scale is part of the restart list; a file of the format before it restores none
+  double list[MTS::RESTART_SIZE];
+  m.write_restart(list);
+  MTS r(settings(8, 1e-3, true, 4.0));
+  ASSERT_TRUE(r.read_restart(list));
+  EXPECT_EQ(r.field_scale(), m.field_scale());
+  list[0] = -2.0;
+  ASSERT_TRUE(r.read_restart(list));
+  EXPECT_EQ(r.field_scale(), 0.0);
+  // no charge: scale 0, not a division by zero
+  const double none[2] = {0.0, 0.0};
+  m.set_field_scale(none);
+  EXPECT_EQ(m.field_scale(), 0.0);
+  // counts of the fix's vector and of a run
+  m.count_absorbed(3.0);
+  m.count_forced();
+  m.start_run_counts();
+  m.count_absorbed(2.0);
+  EXPECT_EQ(m.absorbed_total().changes, 5.0);
+  EXPECT_EQ(m.absorbed_total().forced, 1.0);
+  EXPECT_EQ(m.absorbed_this_run().changes, 2.0);
+  EXPECT_EQ(m.absorbed_this_run().forced, 0.0);
+}

@@ -272,14 +272,14 @@ TEST(TriboCharge, RestartKeepsTheContactRecords)
    periodic in x and y, with the field of fix coul/fmm; on 1 and 2 ranks
 ------------------------------------------------------------------------- */
 
-TEST(TriboCharge, BinaryPowderSeparatesSignsAndConservesCharge)
+void pour_binary_powder(const std::string &pair_style, const std::string &wall_style)
 {
   Lmp l;
   const std::string model = "jkr/marshall 2e8 0.5 0.33 0.02 damping marshall tangential marshall 0.3";
   l.cmds({"units si", "atom_style hybrid sphere charge", "atom_modify map array", "boundary p p f",
           "newton off", "comm_modify vel yes", "region box block 0 1.2e-5 0 1.2e-5 0 4e-5",
           "create_box 2 box", "neighbor 3e-7 bin", "neigh_modify every 1 delay 0 check yes",
-          "pair_style granular", "pair_coeff * * " + model,
+          "pair_style " + pair_style, "pair_coeff * * " + model,
           "lattice sc 3e-6", "region pile block 0 1.2e-5 0 1.2e-5 2e-6 3.5e-5 units box",
           "create_atoms 1 region pile",
           "set type 1 type/fraction 2 0.5 4711",
@@ -288,7 +288,7 @@ TEST(TriboCharge, BinaryPowderSeparatesSignsAndConservesCharge)
           "velocity all create 2e7 4711 loop geom",
           "velocity all set NULL NULL -0.5 sum yes",
           "fix integrate all nve/sphere", "fix grav all gravity 9.81 vector 0 0 -1",
-          "fix floor all wall/gran granular " + model + " zplane 0.0 NULL",
+          "fix floor all " + wall_style + " granular " + model + " zplane 0.0 NULL",
           "fix coul all coul/fmm accuracy 1e-5 every 16 near 6e-6",
           "fix tc all tribo/charge z0 4e-10 potential 0.0 0.5 wall floor 0.25",
           "timestep 1e-9",
@@ -316,6 +316,17 @@ TEST(TriboCharge, BinaryPowderSeparatesSignsAndConservesCharge)
   l.cmd("run 0 post no");
   EXPECT_GT(l.var("c_q1"), 0.0);
   EXPECT_LT(l.var("c_q2"), 0.0);
+}
+
+TEST(TriboCharge, BinaryPowderSeparatesSignsAndConservesCharge)
+{
+  pour_binary_powder("granular", "wall/gran");
+}
+
+// the fused styles of the package hold the same contact models
+TEST(TriboCharge, BinaryPowderWithTheFusedStyles)
+{
+  pour_binary_powder("granular/opt", "wall/gran/opt");
 }
 
 /* ---------------------------------------------------------------------- */

@@ -9,6 +9,8 @@ gc_lammps_test(test_coul_fmm NP 1 2 SOURCES test_coul_fmm.cpp)
 gc_lammps_test(test_coul_fmm_distributed NP 1 2 3 SOURCES test_coul_fmm_distributed.cpp)
 # fix coul/fmm's time stepping alone (no LAMMPS instance)
 gc_lammps_test(test_coul_fmm_time_stepping SOURCES test_coul_fmm_time_stepping.cpp)
+# charge changes absorbed between evaluations (keyword qchange), on 1 and 2 ranks
+gc_lammps_test(test_coul_fmm_absorb NP 1 2 SOURCES test_coul_fmm_absorb.cpp)
 gc_lammps_test(test_packing_computes NP 1 2 SOURCES test_packing_computes.cpp)
 gc_lammps_test(test_granular_opt NP 1 2 SOURCES test_granular_opt.cpp)
 target_compile_definitions(test_granular_opt PRIVATE GC_LMP_EXECUTABLE="$<TARGET_FILE:lmp>")
