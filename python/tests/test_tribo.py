@@ -363,7 +363,8 @@ def test_a_bipolar_binary_charges_by_its_potentials(tribo_build, tmp_path, injec
     defined although every particle starts neutral; charge is conserved; species 2 (higher
     potential) ends negative on average and species 1 positive."""
     # plane, sequential: H = 60 r_p (the start plane, 7 r_p above the bed top, stays in the box
-    # even when a pair of opposite charges hovers high above the 16 particles' bed)
+    # longer when a pair of opposite charges rests high above the 16 particles' bed; above the
+    # box the deck ends the deposition, with a warning, and the identities hold all the same)
     text = lmp_run(tribo_build, DECK, tmp_path,
                    dict(BIPOLAR, inject=inject, H_rp=30 if inject == "rain" else 60))
     assert re.search(r"^fix coul all coul/fmm", text, re.M)
