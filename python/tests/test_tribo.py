@@ -457,3 +457,18 @@ def test_a_run_charged_by_contacts_is_labelled_so():
     assert studytables.charge_label(r) == "injected uncharged, charged by contacts"
     r = {"params": {"q": 100.0, "extra": {}}}
     assert studytables.charge_label(r) == "q 100 e0"
+
+
+def test_a_start_plane_above_the_box_ends_the_deposition(build_dir, tmp_path):
+    """The plane rain in a box 8 + 4 r_p high: once the bed top plus the start height (7 r_p in a
+    box 4 r_p wide) is above the box, the deck ends the deposition with a warning and its result
+    line (LAMMPS's create_atoms would stop the run with an error: the case of a cluster of
+    opposite charges resting near the lid, made here by the bed itself)."""
+    text = lmp_run(build_dir, DECK, tmp_path, {"N": 40, "L_rp": 4, "H_rp": 8, "seed": 1,
+                                               "inject": "plane"})
+    m = re.search(r"^GC WARNING: particle (\d+): the start height z = (\S+) is above the box "
+                  r".*deposition ends with (\d+) particles$", text, re.M)
+    assert m, text[-2000:]
+    k, z, made = int(m.group(1)), float(m.group(2)), int(m.group(3))
+    assert made == k - 1 < 40 and z + 0.01 * 2e-6 >= (8 + 4) * 2e-6
+    assert result_line(text)["inserted"] == str(made)
