@@ -82,6 +82,10 @@ void CoulFMMChargeScheme::init_absorbing()
   CoulFMMTimeStepping &mts = *p.stepping;
   const double tau = mts.settings().tolerance > 0.0 ? mts.settings().tolerance : p.opts->accuracy;
   mts.set_absorbing(wanted && mts.refreshes_near(), tau);
+  // said once per setting: a deck that runs one short run per particle would repeat it
+  const std::string setting = fmt::format("{} {} {} {}", wanted, mts.refreshes_near(), by, tau);
+  if (setting == absorbing_said) return;
+  absorbing_said = setting;
   if (wanted && !mts.refreshes_near() && comm->me == 0)
     error->warning(FLERR,
                    "Fix coul/fmm {}: charge changes are evaluated, not absorbed ({}): absorbing "

@@ -18,6 +18,7 @@
 #include "coul_fmm_scheme.h"
 #include "pointers.h"
 
+#include <string>
 #include <memory>
 
 namespace LAMMPS_NS {
@@ -47,6 +48,7 @@ class CoulFMMChargeScheme : public CoulFMMScheme, protected Pointers {
   double nevaluations;
   bool forced;                // this step's evaluation is forced by absorbed changes' far part
   double pending_absorbed;    // charge changes of this step, absorbed if the field is continued
+  std::string absorbing_said;    // the absorbing setting last said in the log
   void compute_field(bool with_slope, bool brought_forward = false);
   bool advance_field();
   void init_absorbing();
