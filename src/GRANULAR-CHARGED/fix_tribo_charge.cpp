@@ -296,6 +296,7 @@ double *FixTriboCharge::add_record(int i, double key)
   rec[0] = key;
   rec[1] = 0.0;
   rec[2] = -1.0;
+  rec[3] = -std::numeric_limits<double>::max();
   r[NREC] = n + 1;
   return rec;
 }
@@ -435,8 +436,14 @@ void FixTriboCharge::charge_pair(int i, int j, bigint step, std::vector<int> &ch
   if (rec_j) rec_j[2] = (double) step;
 
   const double r = std::sqrt(rsq);
-  const double a_contact = MK::jkr_normal_force(sc, ga, em, radsum - r, reff).a;
+  // the area grows with the overlap (the stable JKR branch): no growth while the overlap stays
+  // within the one charged over, and no contact radius to solve for
+  const double delta = radsum - r;
+  if (!(delta > rec_i[3])) return;
+  const double a_contact = MK::jkr_normal_force(sc, ga, em, delta, reff).a;
   const double area = MathConst::MY_PI * a_contact * a_contact;
+  rec_i[3] = delta;
+  if (rec_j) rec_j[3] = delta;
   if (!(area > rec_i[1])) return;
   const double darea = area - rec_i[1];
   rec_i[1] = area;
@@ -500,7 +507,10 @@ void FixTriboCharge::charge_walls(bigint step, std::vector<int> &changed)
         if (!MK::jkr_touch(was, dist * dist, rad, sc.deltac)) continue;
         if (!rec) rec = add_record(i, key);
         rec[2] = (double) step;
-        const double a_contact = MK::jkr_normal_force(sc, wall.gamma, wall.emix, rad - dist, rad).a;
+        const double delta = rad - dist;
+        if (!(delta > rec[3])) continue;
+        rec[3] = delta;
+        const double a_contact = MK::jkr_normal_force(sc, wall.gamma, wall.emix, delta, rad).a;
         const double area = MathConst::MY_PI * a_contact * a_contact;
         if (!(area > rec[1])) continue;
         const double darea = area - rec[1];

@@ -69,9 +69,10 @@ class FixTriboCharge : public Fix {
  private:
   // the per-atom row: the charge the atom would have without contacts, the quanta it gained,
   // the charge this fix last gave it (a different one was set by someone else: rebased), and
-  // its contact records (partner tag, or -1 - plane for a wall; area charged over; step seen)
+  // its contact records (partner tag, or -1 - plane for a wall; area charged over; step seen;
+  // the overlap of that area)
   enum Row : int { QBASE = 0, GAINED = 1, QSET = 2, NREC = 3, RECORDS = 4 };
-  static constexpr int REC_SIZE = 3;
+  static constexpr int REC_SIZE = 4;
 
   struct Wall {
     class FixWallGran *fix;
