@@ -596,6 +596,7 @@ int FixTriboCharge::pack_exchange(int i, double *buf)
 int FixTriboCharge::unpack_exchange(int nlocal, double *buf)
 {
   for (int k = 0; k < rowsize; k++) row[nlocal][k] = buf[k];
+  vector_atom[nlocal] = row[nlocal][GAINED] * quantum;
   return rowsize;
 }
 

@@ -20,7 +20,8 @@
    test fails: the charge runs away), the area (pi a instead of pi a^2: the wall and pair tests
    fail), a factor 2 in condenser_charge (all closed-form tests fail), the rank of the lower tag
    no longer adding its quanta for a pair of two ranks or images (the conservation test fails),
-   the records not read back from the restart file (the restart test fails). */
+   the records not read back from the restart file (the restart test fails), the per-atom
+   vector not set for an atom received from another rank (the powder tests fail on 2 ranks). */
 #include "gc_testing.h"
 
 #include "gtest/gtest.h"
@@ -295,7 +296,13 @@ void pour_binary_powder(const std::string &pair_style, const std::string &wall_s
           "thermo 1000", "thermo_style custom step f_tc[1] f_tc[2] f_tc[3] f_tc[4] f_tc[5]"});
   const int n = (int) l.var("count(all)");
   ASSERT_GE(n, 60);
+  // the per-atom vector is each atom's charge gained, here its whole charge (injected
+  // uncharged): exactly, also for atoms that moved to another rank (read at the run's last
+  // step, not after a new run's setup)
+  l.cmds({"variable off atom abs(f_tc-q)", "compute offmax all reduce max v_off",
+          "thermo_style custom step f_tc[1] f_tc[2] f_tc[3] f_tc[4] f_tc[5] c_offmax"});
   l.cmd("run 8000");
+  EXPECT_EQ(l.var("c_offmax"), 0.0);
   // contacts happened, between particles and with the floor
   EXPECT_GT(l.var("f_tc[3]"), 10.0);
   EXPECT_GT(l.var("f_tc[4]"), 5.0);
@@ -308,6 +315,7 @@ void pour_binary_powder(const std::string &pair_style, const std::string &wall_s
   l.cmd("run 0 post no");
   const double total = l.var("c_qtot"), wall = l.var("f_tc[2]");
   EXPECT_NEAR(total, wall, 1e-12 * (l.var("f_tc[1]") + std::fabs(wall)));
+  EXPECT_EQ(l.var("c_offmax"), 0.0);
   // type 2 (V = 0.5) below type 1 (V = 0): type 2 negative, type 1 positive on average
   l.cmd("group t1 type 1");
   l.cmd("group t2 type 2");
