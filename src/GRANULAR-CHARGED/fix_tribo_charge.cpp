@@ -367,7 +367,7 @@ void FixTriboCharge::post_force(int)
   const bigint step = update->ntimestep;
   rebase_charges();
   exchange_inputs();
-  std::vector<int> changed;
+  changed.clear();
 
   const int nlocal = atom->nlocal;
   int *mask = atom->mask;

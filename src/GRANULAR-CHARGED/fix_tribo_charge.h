@@ -105,6 +105,8 @@ class FixTriboCharge : public Fix {
 
   // cumulative on this rank: quanta moved between particles, given by walls, events
   double moved_pair, given_wall, events_pair, events_wall;
+  std::vector<int> changed;    // local atoms whose gained quanta changed this step (kept: no
+                               // allocation per step)
 
   void check_pair_model();
   void find_walls();
