@@ -150,7 +150,7 @@ def _table() -> list:
           W("inject", ("auto", "rain", "plane", "sequential")),
           W("farfield", ("exact", "average", "none")),
           W("coul_extrapolate", YESNO), W("coul_solver", ("replicated", "distributed")),
-          W("electrode", YESNO), W("sleep", YESNO), W("split_log", YESNO), W("resume", YESNO), W("pair_opt", YESNO),
+          W("electrode", YESNO), W("sleep", ("yes", "no", "auto")), W("split_log", YESNO), W("resume", YESNO), W("pair_opt", YESNO),
           W("damping_model", ("marshall", "marshall/printed")),
           W("rolling_model", ("marshall", "marshall/particle")),
           N("U0", "v_@ > 0", "finite and > 0 [m/s] (the time step and the injection interval divide by it)"),
@@ -189,6 +189,10 @@ def _table() -> list:
           N("sleep_every", WHOLE + " && v_@ >= 1", "a whole number of steps >= 1"),
           N("sleep_relax", "v_@ >= 0", ">= 0 [r_p / U_0]"),
           N("sleep_depth", "v_@ >= 0", ">= 0 [r_p] (0: off)"),
+          N("sleep_depth", "v_@ > 0", "> 0 [r_p] with sleep auto (its threshold is "
+            "sleep_auto sleep_depth)", when="x${sleep} == xauto"),
+          N("sleep_auto", "v_@ > 0", "> 0 (sleep auto: sleeping when the bed is expected to "
+            "be taller than this many sleep_depth)"),
           N("checkpoint", WHOLE + " && v_@ >= 0",
             "a whole number of particles >= 0 (0: no restart points)"),
           N("checkpoint_stop", WHOLE + " && v_@ >= 0", "a whole number of particles >= 0"),
@@ -272,6 +276,14 @@ def _table() -> list:
               D(f"gc_tb{x}", ERF_T.format(z=f"gc_zb{x}")),
               D(f"gc_mass{x}", f"({_phi(f'gc_zb{x}', f'gc_tb{x}')})-"
                                f"({_phi(f'gc_za{x}', f'gc_ta{x}')})"),
+              # the clipped lognormal's mean r^3 [m^3] (sleep auto's bed height):
+              # rp^3 exp(9 s^2 / 2) (Phi(zb - 3 s) - Phi(za - 3 s)) / mass, s = ln rp_gsd
+              D(f"gc_za3{x}", f"v_gc_za{x}-3.0*ln(v_rp_gsd{x})"),
+              D(f"gc_zb3{x}", f"v_gc_zb{x}-3.0*ln(v_rp_gsd{x})"),
+              D(f"gc_ta3{x}", ERF_T.format(z=f"gc_za3{x}")),
+              D(f"gc_tb3{x}", ERF_T.format(z=f"gc_zb3{x}")),
+              D(f"gc_m3{x}", f"v_rp{x}^3*exp(4.5*ln(v_rp_gsd{x})^2)*(({_phi(f'gc_zb3{x}', f'gc_tb3{x}')})-"
+                             f"({_phi(f'gc_za3{x}', f'gc_ta3{x}')}))/v_gc_mass{x}"),
               N(f"rp_gsd{x}", f"v_gc_mass{x} >= {MIN_LOGNORMAL_MASS}",
                 f"the lognormal (median ${{rp{x}}} m) has $(v_gc_mass{x}:%.3g) of its particles "
                 f"in rp_lo{x} .. rp_hi{x} = $(v_gc_lo{x}:%.3g) .. $(v_gc_hi{x}:%.3g) m, less "
@@ -509,6 +521,13 @@ def lognormal_mass(median: float, gsd: float, lo: float, hi: float) -> float:
     """The probability of a lognormal (median, gsd) inside lo .. hi, as the rules compute it."""
     vals = Values({"rp": median, "rp_gsd": gsd, "rp_lo": lo, "rp_hi": hi}, {})
     return vals.number("gc_mass")
+
+
+def lognormal_mean_r3(median: float, gsd: float, lo: float, hi: float) -> float:
+    """The mean r^3 [m^3] of a lognormal (median, gsd) clipped to lo .. hi (0: the deck's
+    default clip), as the deck computes it for sleep auto (the derived variable gc_m3)."""
+    vals = Values({"rp": median, "rp_gsd": gsd, "rp_lo": lo, "rp_hi": hi}, {})
+    return vals.number("gc_m3")
 
 
 # ---- the deck: the generated checking block -----------------------------------------------
