@@ -253,15 +253,19 @@ def test_the_run_key_names_sleep_auto():
     assert DepositionParams(N=100, extra={"sleep": "auto", "sleep_auto": "4"}).key() != auto.key()
 
 
-def test_sleep_auto_through_the_command_line(cli, tmp_path):
+@pytest.mark.parametrize("extra, chosen, line", [
+    ([], "no", "expected bed height 4.09 r_p <= 45 r_p: sleeping off"),
+    (["--var", "sleep_auto", "0.2"], "yes",
+     "expected bed height 4.09 r_p > 3 r_p: deep sleeping on (depth 15 r_p)")])
+def test_sleep_auto_through_the_command_line(cli, tmp_path, extra, chosen, line):
     """granular-charged run --var sleep auto: the deck gets it (its GC SLEEP line in the run's
-    log), result.json records it."""
+    log), result.json records it and what it chose."""
     import json
     r = cli(["-q", "run", "--out", tmp_path / "runs", "--seed", 3, "--N", TINY["N"],
              "--var", "L_rp", TINY["L_rp"], "--var", "H_rp", TINY["H_rp"],
-             "--var", "sleep", "auto", "--no-render"], tmp_path)
+             "--var", "sleep", "auto", *extra, "--no-render"], tmp_path)
     rf = Path(r.stdout.strip().splitlines()[-1])
     res = json.loads(rf.read_text())
-    assert res["params"]["extra"]["sleep"] == "auto"
+    assert res["params"]["extra"]["sleep"] == "auto" and res["sleep"] == chosen
     logs = "".join(p.read_text(errors="replace") for p in rf.parent.glob("log*.lammps"))
-    assert "GC SLEEP auto: expected bed height 4.09 r_p <= 45 r_p: sleeping off" in logs
+    assert "GC SLEEP auto: " + line in logs
