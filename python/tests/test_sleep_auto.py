@@ -2,8 +2,8 @@
 than sleep_auto sleep_depth, else it runs as with sleep no.
 
 The rule has two homes that must agree: the deck's section "sleeping particles: the choice of
-sleep auto" (in.deposition, LAMMPS's formulas) and granular_charged/run/population.py,
-sleep_auto (Python); the clipped lognormal's mean r^3 has one, the derived variable gc_m3 of
+sleep auto" (in.deposition, LAMMPS's formulas) and granular_charged/rules.py, sleep_auto
+(Python); the clipped lognormal's mean r^3 has one, the derived variable gc_m3 of
 granular_charged/rules.py, which both evaluate. test_the_deck_and_python_choose_alike checks the
 two homes against each other over random runs; the closed forms are checked against numerical
 integration. The deck's set-up alone (up to its first run) answers what the deck chooses and
@@ -19,7 +19,6 @@ import pytest
 
 from granular_charged import rules
 from granular_charged.params import DepositionParams, ParamError
-from granular_charged.run import population
 from lammps_runs import DECK, lmp_run
 from rule_cases import _lmp
 
@@ -82,7 +81,7 @@ def test_auto_is_on_for_a_tall_bed(build_dir, tmp_path):
     fix = [c for c in _commands(auto) if "sleep/gran" in c]
     assert len(fix) == 1, fix
     depth = float(re.search(r" depth (\S+)", fix[0]).group(1))
-    assert depth == pytest.approx(15 * 2e-6, rel=1e-12), fix
+    assert depth == pytest.approx(15 * 2e-6, rel=1e-12, abs=0), fix
     assert _sleep_lines(auto) == ["GC SLEEP auto: expected bed height 167 r_p > 45 r_p: deep "
                                   "sleeping on (depth 15 r_p)"], _sleep_lines(auto)
 
@@ -154,30 +153,40 @@ def test_the_lognormal_mean_r3_is_the_integral(median, gsd, lo, hi):
     a, b = lo or median / gsd ** 3, hi or median * gsd ** 3
     exact = integrate.quad(lambda r: r ** 3 * ln.pdf(r), a, b, epsabs=0, epsrel=1e-12,
                            limit=200)[0] / (ln.cdf(b) - ln.cdf(a))
-    assert rules.lognormal_mean_r3(median, gsd, lo, hi) == pytest.approx(exact, rel=1e-5)
+    assert rules.lognormal_mean_r3(median, gsd, lo, hi) == pytest.approx(exact, rel=1e-5, abs=0)
 
 
 def test_mean_r3_of_the_other_size_rules():
-    """uniform in r: the integral of r^3 / (hi - lo); discrete: the weighted mean of r^3."""
+    """uniform in r: the integral of r^3 / (hi - lo); discrete: the weighted mean of r^3.
+    (Radii in m: every comparison is relative, abs=0.)"""
     from scipy import integrate
+    from granular_charged.run.deckfile import deck_variables
+    deck = deck_variables("in.deposition")
+
+    def m3(given, s=1):
+        return rules.mean_r3(rules.Values(given, deck), s)
     lo, hi = 1.5e-6, 3.5e-6
     exact = integrate.quad(lambda r: r ** 3, lo, hi)[0] / (hi - lo)
-    assert population.mean_r3({"dist": "uniform", "lo": lo, "hi": hi}) == \
-        pytest.approx(exact, rel=1e-12)
-    d = {"dist": "discrete", "radii": [1e-6, 3e-6], "fractions": [3, 1]}
-    assert population.mean_r3(d) == pytest.approx((3 * 1e-18 + 27e-18) / 4, rel=1e-12)
-    assert population.mean_r3({"dist": "one", "r": 2e-6}) == pytest.approx(8e-18, rel=1e-12)
+    assert m3({"r_dist": "uniform", "rp_lo": lo, "rp_hi": hi}) == \
+        pytest.approx(exact, rel=1e-12, abs=0)
+    disc = {"species": 2, "r_dist_2": "discrete", "radii_2": "1e-6 3e-6"}
+    assert m3(dict(disc, rfrac_2="3 1"), 2) == \
+        pytest.approx((3 * 1e-18 + 27e-18) / 4, rel=1e-12, abs=0)
+    assert m3(disc, 2) == pytest.approx((1e-18 + 27e-18) / 2, rel=1e-12, abs=0)
+    assert m3({"rp": 2e-6}) == pytest.approx(8e-18, rel=1e-12, abs=0)
+    # species 2's radius is species 1's when not given (rp_2 = ${rp})
+    assert m3({"species": 2, "rp": 3e-6}, 2) == pytest.approx(27e-18, rel=1e-12, abs=0)
 
 
 def test_python_chooses_by_the_height():
     """The paper's bed: 2000 (4/3 pi) / (0.64 x 784) = 16.7 r_p, off; ten times as many, on;
     sleep yes and no are themselves whatever the height."""
-    paper = population.sleep_auto(dict(PAPER, sleep="auto"))
+    paper = rules.sleep_auto(dict(PAPER, sleep="auto"))
     assert paper["height_rp"] == pytest.approx(2000 * 4 / 3 * math.pi / (0.64 * 784), rel=1e-12)
     assert paper["threshold_rp"] == 45 and paper["sleep"] == "no"
-    assert population.sleep_auto(dict(TALL, sleep="auto"))["sleep"] == "yes"
-    assert population.sleep_auto(dict(TALL, sleep="no"))["sleep"] == "no"
-    assert population.sleep_auto(dict(PAPER, sleep="yes"))["sleep"] == "yes"
+    assert rules.sleep_auto(dict(TALL, sleep="auto"))["sleep"] == "yes"
+    assert rules.sleep_auto(dict(TALL, sleep="no"))["sleep"] == "no"
+    assert rules.sleep_auto(dict(PAPER, sleep="yes"))["sleep"] == "yes"
 
 
 def _random_run(rng):
@@ -231,7 +240,7 @@ def test_the_deck_and_python_choose_alike(build_dir, tmp_path):
         d.mkdir()
         log = _setup_log(build_dir, d, v, upto="# ---------------- system ---")
         (h, thr), deck_on = _test_values(log)
-        py = population.sleep_auto(v)
+        py = rules.sleep_auto(v)
         assert h == pytest.approx(py["height_rp"], rel=1e-9), v
         assert thr == pytest.approx(py["threshold_rp"], rel=1e-12), v
         assert abs(h / thr - 1) > 1e-9, ("a tie drawn", v)
@@ -244,12 +253,17 @@ def test_the_deck_and_python_choose_alike(build_dir, tmp_path):
 # ---- the run key and the command line --------------------------------------------------------
 
 def test_the_run_key_names_sleep_auto():
-    """sleep auto is a non-default value (the key's hash); sleep_auto at its default is not."""
+    """A value of sleep other than the deck's default enters the key (its hash), the default
+    does not; sleep_auto likewise."""
+    from granular_charged.run.deckfile import deck_variables
+    default = deck_variables("in.deposition")["sleep"]
+    other = "no" if default == "auto" else "auto"
     base = DepositionParams(N=100)
+    assert DepositionParams(N=100, extra={"sleep": default}).key() == base.key()
+    changed = DepositionParams(N=100, extra={"sleep": other})
+    assert changed.key() != base.key() and changed.non_default()["sleep"] == other
     auto = DepositionParams(N=100, extra={"sleep": "auto"})
-    assert auto.key() != base.key() and auto.non_default()["sleep"] == "auto"
-    at_default = DepositionParams(N=100, extra={"sleep": "auto", "sleep_auto": "3.0"})
-    assert at_default.key() == auto.key()
+    assert DepositionParams(N=100, extra={"sleep": "auto", "sleep_auto": "3.0"}).key() == auto.key()
     assert DepositionParams(N=100, extra={"sleep": "auto", "sleep_auto": "4"}).key() != auto.key()
 
 

@@ -264,54 +264,6 @@ def protocol(vars_: dict) -> str:
     return "plane" if is_charged(vars_) else "rain"
 
 
-# ---- sleep auto: the deck's choice of sleeping (its section "sleeping particles: the choice of
-# sleep auto"; the same rule, which python/tests/test_sleep_auto.py checks against the deck) ----
-
-# the packing fraction of the expected bed height: random close packing of equal spheres, denser
-# than any bed the deck deposits (measured 0.20-0.50: doc/reproduction.md, doc/deposition.md), so
-# the height is at most the bed's real one and sleep auto errs toward sleeping off
-SLEEP_AUTO_PHI = 0.64
-
-
-def mean_r3(size: dict) -> float:
-    """The mean r^3 [m^3] of a size spec as the deck draws it: one r^3; uniform (in r)
-    (hi^4 - lo^4) / (4 (hi - lo)); the lognormal clipped to lo .. hi (rules.lognormal_mean_r3,
-    the deck's own formula); discrete the weighted mean of the radii's cubes."""
-    from .. import rules
-    d = size["dist"]
-    if d == "one":
-        return size["r"] ** 3
-    if d == "uniform":
-        lo, hi = size["lo"], size["hi"]
-        return (hi ** 4 - lo ** 4) / (4.0 * (hi - lo))
-    if d == "lognormal":
-        lo, hi = bounds(size)
-        return rules.lognormal_mean_r3(size["median"], size["gsd"], lo, hi)
-    radii = size["radii"]
-    f = size.get("fractions") or [1.0] * len(radii)
-    return sum(r ** 3 * w for r, w in zip(radii, f)) / sum(f)
-
-
-def sleep_auto(vars_: dict, defaults: dict | None = None) -> dict:
-    """The deck's sleep rule for a run's deck variables (over the deck's defaults):
-    {'sleep': yes or no, the setting the run uses; 'height_rp': the bed's expected height
-    N <4/3 pi r^3> / (SLEEP_AUTO_PHI L^2) in r_p; 'threshold_rp': sleep_auto sleep_depth}.
-    sleep yes and no are themselves; auto is yes when the height exceeds the threshold."""
-    from ..rules import Values
-    if defaults is None:
-        from .deckfile import deck_variables
-        defaults = deck_variables("in.deposition")
-    v = Values(vars_, defaults).text
-    rp, L_rp, N = float(v["rp"]), float(v["L_rp"]), float(v["N"])
-    m3 = sum(sp["fraction"] * mean_r3(sp["size"]) for sp in describe(v)["species"])
-    height = N * 4.0 / 3.0 * math.pi * m3 / (SLEEP_AUTO_PHI * (L_rp * rp) ** 2) / rp
-    threshold = float(v["sleep_auto"]) * float(v["sleep_depth"])
-    sleep = v["sleep"]
-    if sleep == "auto":
-        sleep = "yes" if height > threshold else "no"
-    return {"sleep": sleep, "height_rp": height, "threshold_rp": threshold}
-
-
 # ---- the distributions, for tests and the analysis ------------------------------------------
 
 def radius_cdf(size: dict):
