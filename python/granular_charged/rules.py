@@ -21,6 +21,9 @@ lets such a value through.
 
 params.check_deck_values raises the first failed rule as a ParamError.
 
+The deck's sleep auto decides from its inputs too: ``sleep_auto`` gives its choice as Python
+makes it (the deck makes it in its own section, in LAMMPS's formulas).
+
 ``python -m granular_charged.rules --write`` writes the block into the packaged deck;
 ``--check`` exits 1 when the deck's block differs from the table (python/tests/test_rules.py
 checks the same).
@@ -150,7 +153,7 @@ def _table() -> list:
           W("inject", ("auto", "rain", "plane", "sequential")),
           W("farfield", ("exact", "average", "none")),
           W("coul_extrapolate", YESNO), W("coul_solver", ("replicated", "distributed")),
-          W("electrode", YESNO), W("sleep", YESNO), W("split_log", YESNO), W("resume", YESNO), W("pair_opt", YESNO),
+          W("electrode", YESNO), W("sleep", ("yes", "no", "auto")), W("split_log", YESNO), W("resume", YESNO), W("pair_opt", YESNO),
           W("damping_model", ("marshall", "marshall/printed")),
           W("rolling_model", ("marshall", "marshall/particle")),
           N("U0", "v_@ > 0", "finite and > 0 [m/s] (the time step and the injection interval divide by it)"),
@@ -189,6 +192,10 @@ def _table() -> list:
           N("sleep_every", WHOLE + " && v_@ >= 1", "a whole number of steps >= 1"),
           N("sleep_relax", "v_@ >= 0", ">= 0 [r_p / U_0]"),
           N("sleep_depth", "v_@ >= 0", ">= 0 [r_p] (0: off)"),
+          N("sleep_depth", "v_@ > 0", "> 0 [r_p] with sleep auto (its threshold is "
+            "sleep_auto sleep_depth)", when="x${sleep} == xauto"),
+          N("sleep_auto", "v_@ > 0", "> 0 (sleep auto: sleeping when the bed is expected to "
+            "be taller than this many sleep_depth)"),
           N("checkpoint", WHOLE + " && v_@ >= 0",
             "a whole number of particles >= 0 (0: no restart points)"),
           N("checkpoint_stop", WHOLE + " && v_@ >= 0", "a whole number of particles >= 0"),
@@ -272,6 +279,14 @@ def _table() -> list:
               D(f"gc_tb{x}", ERF_T.format(z=f"gc_zb{x}")),
               D(f"gc_mass{x}", f"({_phi(f'gc_zb{x}', f'gc_tb{x}')})-"
                                f"({_phi(f'gc_za{x}', f'gc_ta{x}')})"),
+              # the clipped lognormal's mean r^3 [m^3] (sleep auto's bed height):
+              # rp^3 exp(9 s^2 / 2) (Phi(zb - 3 s) - Phi(za - 3 s)) / mass, s = ln rp_gsd
+              D(f"gc_za3{x}", f"v_gc_za{x}-3.0*ln(v_rp_gsd{x})"),
+              D(f"gc_zb3{x}", f"v_gc_zb{x}-3.0*ln(v_rp_gsd{x})"),
+              D(f"gc_ta3{x}", ERF_T.format(z=f"gc_za3{x}")),
+              D(f"gc_tb3{x}", ERF_T.format(z=f"gc_zb3{x}")),
+              D(f"gc_m3{x}", f"v_rp{x}^3*exp(4.5*ln(v_rp_gsd{x})^2)*(({_phi(f'gc_zb3{x}', f'gc_tb3{x}')})-"
+                             f"({_phi(f'gc_za3{x}', f'gc_ta3{x}')}))/v_gc_mass{x}"),
               N(f"rp_gsd{x}", f"v_gc_mass{x} >= {MIN_LOGNORMAL_MASS}",
                 f"the lognormal (median ${{rp{x}}} m) has $(v_gc_mass{x}:%.3g) of its particles "
                 f"in rp_lo{x} .. rp_hi{x} = $(v_gc_lo{x}:%.3g) .. $(v_gc_hi{x}:%.3g) m, less "
@@ -509,6 +524,66 @@ def lognormal_mass(median: float, gsd: float, lo: float, hi: float) -> float:
     """The probability of a lognormal (median, gsd) inside lo .. hi, as the rules compute it."""
     vals = Values({"rp": median, "rp_gsd": gsd, "rp_lo": lo, "rp_hi": hi}, {})
     return vals.number("gc_mass")
+
+
+def lognormal_mean_r3(median: float, gsd: float, lo: float, hi: float) -> float:
+    """The mean r^3 [m^3] of a lognormal (median, gsd) clipped to lo .. hi (0: the deck's
+    default clip), as the deck computes it for sleep auto (the derived variable gc_m3)."""
+    vals = Values({"rp": median, "rp_gsd": gsd, "rp_lo": lo, "rp_hi": hi}, {})
+    return vals.number("gc_m3")
+
+
+# ---- sleep auto: the deck's choice of sleeping ---------------------------------------------
+# The deck's section "sleeping particles: the choice of sleep auto" states the same rule in
+# LAMMPS's formulas; python/tests/test_sleep_auto.py checks the two against each other.
+
+# the packing fraction of the expected bed height: random close packing of equal spheres, denser
+# than any bed the deck deposits (measured 0.20-0.50: doc/reproduction.md, doc/deposition.md), so
+# the height is at most the bed's real one and sleep auto errs toward sleeping off
+SLEEP_AUTO_PHI = 0.64
+
+
+def mean_r3(vals: Values, s: int) -> float:
+    """The mean r^3 [m^3] of species s's radii as the deck draws them: r_dist one rp^3; uniform
+    (in r) (hi^4 - lo^4) / (4 (hi - lo)); lognormal clipped to its range (gc_m3, the deck's
+    formula); discrete the mean of the radii's cubes weighted by rfrac (0: equal)."""
+    x = suffix(s)
+    d = vals.text.get(f"r_dist{x}", "one")
+    if d == "uniform":
+        lo, hi = vals.number(f"rp_lo{x}"), vals.number(f"rp_hi{x}")
+        return (hi ** 4 - lo ** 4) / (4.0 * (hi - lo))
+    if d == "lognormal":
+        return vals.number(f"gc_m3{x}")
+    if d == "discrete":
+        radii = [float(w) for w in _list(vals.text.get(f"radii{x}", "0"))]
+        w = [float(f) for f in _list(vals.text.get(f"rfrac{x}", "0"))]
+        if w == [0.0]:
+            w = [1.0] * len(radii)
+        return sum(r ** 3 * f for r, f in zip(radii, w)) / sum(w)
+    return vals.number(f"rp{x}") ** 3
+
+
+def sleep_auto(given: dict, defaults: dict | None = None) -> dict:
+    """The deck's sleep rule for a run's deck variables `given` (over the deck's `defaults`,
+    deckfile.deck_variables when None): {'sleep': yes or no, the setting the run uses;
+    'height_rp': the bed's expected height N <4/3 pi r^3> / (SLEEP_AUTO_PHI L^2) in r_p, <r^3>
+    over the species weighted by their number fractions; 'threshold_rp': sleep_auto
+    sleep_depth}. sleep yes and no are themselves; auto is yes when the height exceeds the
+    threshold. The values must pass the input rules (problems)."""
+    if defaults is None:
+        from .run.deckfile import deck_variables
+        defaults = deck_variables("in.deposition")
+    vals = Values(given, defaults)
+    n = int(vals.number("species"))
+    frac = [vals.number(f"frac{suffix(s)}") if s <= n else 0.0 for s in SPECIES]
+    m3 = sum(f * mean_r3(vals, s) for f, s in zip(frac, SPECIES) if f > 0) / sum(frac)
+    rp, L = vals.number("rp"), vals.number("L_rp") * vals.number("rp")
+    height = vals.number("N") * 4.0 / 3.0 * math.pi * m3 / (SLEEP_AUTO_PHI * L * L) / rp
+    threshold = vals.number("sleep_auto") * vals.number("sleep_depth")
+    sleep = vals.text["sleep"]
+    if sleep == "auto":
+        sleep = "yes" if height > threshold else "no"
+    return {"sleep": sleep, "height_rp": height, "threshold_rp": threshold}
 
 
 # ---- the deck: the generated checking block -----------------------------------------------

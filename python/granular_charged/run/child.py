@@ -53,6 +53,7 @@ def extract_deposition(lmp) -> dict:
         out[k] = int(round(out[k]))
     out["settled"] = bool(out["settled"])    # the stop rule's kinetic-energy criterion met
     out["inject"] = str(lmp.extract_variable("inject"))     # the protocol the run used
+    out["sleep"] = "yes" if _equal(lmp, "sleep_on") else "no"   # sleeping, as sleep auto chose
     out["slab"] = bool(_equal(lmp, "slab_ok"))
     out["phi"] = out["Z"] = None
     out["fZ"] = out["fZ_count"] = []

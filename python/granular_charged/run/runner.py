@@ -678,6 +678,8 @@ class Runner:
             "image": lmp.get("image"),
             # the protocol the deck used (its GC PROTOCOL line), and the population it drew
             "protocol": lmp.get("inject") or population.protocol(p.deck_vars()),
+            # whether particles slept (fix sleep/gran; the choice of sleep auto)
+            "sleep": lmp.get("sleep"),
             "population": population.describe(p.deck_vars()),
         }
         if population.is_population(p.deck_vars()):
