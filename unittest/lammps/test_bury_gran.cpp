@@ -1,7 +1,8 @@
 /* GRANULAR-CHARGED: fix bury/gran takes buried sleepers out of LAMMPS's per-atom work and gives
    the same trajectory as a run without it (doc/fix_bury_gran.rst).
 
-   - SameTrajectoryWithoutTheBuried (1 and 2 ranks, newton off and on): an 8 x 8 x 6 lattice
+   - SameTrajectoryWithoutTheBuried (1 and 2 ranks, newton off and on; pair_style granular,
+     and granular/opt on the first grid with newton off): an 8 x 8 x 6 lattice
      bed falls asleep, 80 spheres rain on it at ~1 m/s and wake sleepers. With fix bury/gran
      (halo 6.5 um) the lower layers are buried (192 atoms before the rain lands, the lowest
      layer of 64 at the end) and every atom's position and sleeping flag after the run equal
@@ -10,8 +11,8 @@
      forces on an atom in another order (relative round-off 1e-16 per step). Measured: 2e-18 m
      at most over 3000 steps; the tolerance 1e-16 m (5e-11 of a diameter) is 50 times that,
      and a contact missed for a single step moves an atom by orders of magnitude more (a
-     sleeper woken next to the buried zone, its support missing for the step of the wake: 3e-4
-     m/s in velocity, 1.6e-5 m in position after 3000 steps). Positions are compared up to a
+     sleeper woken next to the buried zone, its support missing on the step of the wake, with
+     a halo below the one required: 3e-4 m/s in velocity on the next step). Positions are compared up to a
      box length in x and y (the runs wrap atoms into the box on different steps). Also checked
      at the end: buried atoms exist, none is in the pair's neighbor list (as atom or neighbor)
      nor a ghost on any rank, and the list holds exactly the group's owned atoms.
@@ -22,14 +23,19 @@
      (atom 1 stays buried), but are not yet in the list; on the next step the pair's list
      holds them and their contacts, with the histories they had when they were buried (both
      atoms of contacts 2-3 and 3-4 asleep: nothing advances them).
-   - Errors: halo below the neighbor cutoff plus a diameter, the group missing from atom_modify
+   - KeptHistoriesSurviveARestart (1 and 2 ranks): the same, continued from a restart written
+     while atoms 1-3 are buried and read by another instance (whose pair starts its own contact
+     histories afresh): contacts 2-3 and 3-4 come back from fix bury/gran's restart data.
+   - Errors: halo below the neighbor cutoff plus two diameters and the skin, the group missing from atom_modify
      first, neigh_modify include, comm_modify group, no such sleep fix, a fix of another style,
      fix bury/gran before the sleep fix, fix deposit after it.
 
    Checked against broken code: without the forced build after the group changed, the woken
-   sleeper's test finds atoms 1 and 2 outside the list on the next step; with the halo ignored
-   (every sleeper buried), the trajectories differ; with the histories not given back, the
-   rejoined contacts start from zero. */
+   sleeper's test finds contacts 2-3 and 3-4 missing from the list on the next step; with the
+   halo ignored (every sleeper buried: 384) the positions differ by 7.4e-6 m and the sleeping
+   flags differ; with the histories not given back, the
+   rejoined contacts start from zero (and, for the restart, with the kept histories not read
+   back from the restart file). */
 #include "gc_testing.h"
 
 #include "atom.h"
@@ -49,6 +55,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -70,7 +77,8 @@ const std::vector<std::string> ACTIVE = {"group active empty", "atom_modify firs
                                          "comm_modify group active"};
 
 // test_sleep_wake.cpp's rain deck with a bed of 6 layers: asleep at step 1000000, 80 spheres rain
-std::vector<std::string> rain_deck(const std::string &grid, const std::string &newton, bool bury)
+std::vector<std::string> rain_deck(const std::string &grid, const std::string &newton, bool bury,
+                                   const std::string &pair = "granular")
 {
   std::vector<std::string> d = {"units si", "atom_style sphere", "atom_modify map array",
                                 "boundary p p f", "newton " + newton, "comm_modify vel yes",
@@ -80,7 +88,7 @@ std::vector<std::string> rain_deck(const std::string &grid, const std::string &n
   const std::string g = bury ? "active" : "all";
   std::vector<std::string> rest = {
       "region cells block 0 8 0 8 0 5", "create_atoms 1 region cells", "group bed region cells",
-      "set group all diameter 2.0e-6", "set group all density 2500", "pair_style granular",
+      "set group all diameter 2.0e-6", "set group all density 2500", "pair_style " + pair,
       std::string("pair_coeff * * ") + MODEL,
       std::string("fix floor all wall/gran granular ") + MODEL + " zplane -0.999e-6 NULL",
       "neighbor 2e-7 bin", "neigh_modify every 1 delay 0 check yes",
@@ -195,10 +203,13 @@ TEST(BuryGran, SameTrajectoryWithoutTheBuried)
   if (np == 2) grids = {"2 1 1", "1 2 1"};
   if (grids.empty()) GTEST_SKIP() << "grids for 1 and 2 ranks";
   for (const auto &grid : grids) {
-    for (const std::string newton : {"off", "on"}) {
+    // pair_style granular, newton off and on; granular/opt (its own contact list) newton off
+    for (const auto &[newton, pair] : std::vector<std::pair<std::string, std::string>>{
+             {"off", "granular"}, {"on", "granular"}, {"off", "granular/opt"}}) {
+      if (pair == "granular/opt" && grid != grids.front()) continue;
       Lmp ref, bur;
-      ref.cmds(rain_deck(grid, newton, false));
-      bur.cmds(rain_deck(grid, newton, true));
+      ref.cmds(rain_deck(grid, newton, false, pair));
+      bur.cmds(rain_deck(grid, newton, true, pair));
       ref.cmd("run " + std::to_string(NSTEPS));
       bur.cmd("run " + std::to_string(NSTEPS));
       const auto xr = gctest::gather(ref, "x", 3), xb = gctest::gather(bur, "x", 3);
@@ -221,11 +232,11 @@ TEST(BuryGran, SameTrajectoryWithoutTheBuried)
       int bad_all = 0;
       MPI_Allreduce(&bad, &bad_all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
       if (rank() == 0)
-        std::printf("[ grid %s newton %s ] woken %g, buried %g, active %g, recomputes %g, "
+        std::printf("[ %s grid %s newton %s ] woken %g, buried %g, active %g, recomputes %g, "
                     "forced builds %g, largest |dx| %.3g m\n",
-                    grid.c_str(), newton.c_str(), woken, buried, bur.var("f_bury[1]"),
+                    pair.c_str(), grid.c_str(), newton.c_str(), woken, buried, bur.var("f_bury[1]"),
                     bur.var("f_bury[3]"), bur.var("f_bury[4]"), worst);
-      const std::string where = "grid " + grid + ", newton " + newton;
+      const std::string where = pair + ", grid " + grid + ", newton " + newton;
       EXPECT_GT(woken, 10.0) << where << ": the rain wakes sleepers";
       EXPECT_GE(buried, 64.0) << where << ": the lowest layer is buried";
       EXPECT_EQ(bur.var("f_bury[1]") + buried, bur.var("count(all)")) << where;
@@ -240,11 +251,15 @@ TEST(BuryGran, SameTrajectoryWithoutTheBuried)
 // sleepers 1-6 stacked in z (touching: 1.995 um apart), sphere 7 0.115 um above sleeper 6:
 // sleepers 1-3 (more than 6.5 um below sphere 7) are buried; on 2 ranks the column is owned by
 // rank 0 and is a ghost of rank 1
-TEST(BuryGran, WokenSleeperGetsItsBuriedNeighbours)
+// via_restart: the run is continued from a restart written while atoms 1-3 are buried, read by
+// another LAMMPS instance of this process (which starts the pair's own contact histories afresh:
+// LAMMPS names its fix NEIGH_HISTORY per instance), so that the rejoined contacts' histories come
+// from fix bury/gran's per-atom restart data alone
+void woken_sleeper(bool via_restart)
 {
   const int np = nprocs();
-  if (np > 2) GTEST_SKIP() << "1 and 2 ranks";
-  Lmp l;
+  auto owner = std::make_unique<Lmp>();
+  Lmp &l = *owner;
   l.cmds({"units si", "atom_style sphere", "atom_modify map array", "boundary p p f",
           "newton off", "comm_modify vel yes", fmt::format("processors {} 1 1", np),
           "region box block 0 24e-6 0 8e-6 0 20e-6", "create_box 1 box"});
@@ -278,28 +293,45 @@ TEST(BuryGran, WokenSleeperGetsItsBuriedNeighbours)
     EXPECT_GT(kv.first.first, 3) << "a buried atom listed";
     EXPECT_GT(kv.first.second, 3) << "a buried atom listed";
   }
+  if (via_restart) {
+    const std::string file = "bury_gran_woken.restart";
+    l.cmd("write_restart " + file);
+    owner = std::make_unique<Lmp>();
+    owner->cmds({"read_restart " + file, "atom_modify first active", "neigh_modify include active",
+                 "comm_modify group active", "comm_modify vel yes", "pair_style granular",
+                 std::string("pair_coeff * * ") + MODEL, "neighbor 2e-7 bin",
+                 "neigh_modify every 1 delay 0 check yes", "fix integrate active nve/sphere",
+                 "thermo 0",
+                 "fix sleep all sleep/gran speed 1e3 force 1.0 wake 1e-8 time 0 every 1000000",
+                 fmt::format("fix bury all bury/gran sleep sleep active active halo {}", HALO),
+                 "run 0"});
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (rank() == 0) std::remove(file.c_str());
+    EXPECT_EQ(owner->var("f_bury[2]"), 3.0) << "atoms 1, 2 and 3 buried after read_restart";
+  }
+  Lmp &l2 = *owner;
   int steps = 0;
-  while (l.var("f_sleep[4]") == 0.0 && steps < 400) {
-    l.cmd("run 1 pre no post no");
+  while (l2.var("f_sleep[4]") == 0.0 && steps < 400) {
+    l2.cmd("run 1 pre no post no");
     steps++;
   }
-  ASSERT_GT(l.var("f_sleep[4]"), 0.0) << "sphere 7 reaches sphere 6 within 400 steps";
+  ASSERT_GT(l2.var("f_sleep[4]"), 0.0) << "sphere 7 reaches sphere 6 within 400 steps";
   std::vector<double> sleeping(7);
-  lammps_gather(l.lmp, "f_sleep", 1, 1, sleeping.data());
+  lammps_gather(l2.lmp, "f_sleep", 1, 1, sleeping.data());
   EXPECT_EQ(sleeping[5], 0.0) << "sphere 6, pushed, wakes";
   EXPECT_EQ(sleeping[4], 0.0) << "sphere 5 touches sphere 6";
   EXPECT_EQ(sleeping[3], 1.0) << "sphere 4 sleeps";
   // sphere 5 (8.98 um) is the lowest awake: 4, 3 and 2 (6 um below it) rejoin, 1 stays buried
-  EXPECT_EQ(l.var("f_bury[2]"), 1.0) << "on the step of the wake, atoms 2 and 3 rejoin the group";
+  EXPECT_EQ(l2.var("f_bury[2]"), 1.0) << "on the step of the wake, atoms 2 and 3 rejoin the group";
   int in_list_before = 0;
-  for (auto &kv : all_histories(l))
+  for (auto &kv : all_histories(l2))
     if (kv.first.first == 2 || kv.first.second == 2) in_list_before++;
   EXPECT_EQ(in_list_before, 0) << "atom 2 not yet in the list of the last build";
 
-  l.cmd("run 1 pre no post no");
-  const auto rejoined = all_histories(l);
+  l2.cmd("run 1 pre no post no");
+  const auto rejoined = all_histories(l2);
   int listed = 0, in_group = 0, bad = 0;
-  const int mine = buried_in_list_or_ghost(l, listed, in_group);
+  const int mine = buried_in_list_or_ghost(l2, listed, in_group);
   MPI_Allreduce(&mine, &bad, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
   EXPECT_EQ(bad, 0) << "atom 1, buried, in the list or a ghost";
   for (auto &kv : buried_with) {
@@ -330,6 +362,18 @@ TEST(BuryGran, WokenSleeperGetsItsBuriedNeighbours)
   for (const std::pair<int, int> c : {std::make_pair(2, 3), std::make_pair(3, 4)})
     EXPECT_TRUE(rejoined.count(c) || rejoined.count({c.second, c.first}))
         << "contact " << c.first << "-" << c.second << " in the list after the wake";
+}
+
+TEST(BuryGran, WokenSleeperGetsItsBuriedNeighbours)
+{
+  if (nprocs() > 2) GTEST_SKIP() << "1 and 2 ranks";
+  woken_sleeper(false);
+}
+
+TEST(BuryGran, KeptHistoriesSurviveARestart)
+{
+  if (nprocs() > 2) GTEST_SKIP() << "1 and 2 ranks";
+  woken_sleeper(true);
 }
 
 // a one-atom deck with the group commands `active` and the fixes `fixes`, then run 0
