@@ -91,32 +91,31 @@ int column_index(double c, double lo, double w, int n, bool periodic)
   return b;
 }
 
-// the minimum of each element over the window [b - k, b + k] along one axis of a grid of
-// n elements separated by stride (periodic: wrapped; else clamped at the ends)
-void window_min(std::vector<double> &v, int n, int stride, int rows, int row_stride, int k,
-                bool periodic)
+// each flag becomes 1 if any flag of the window [e - k, e + k] along one axis (0, 1, 2) of a
+// grid of n[0] x n[1] x n[2] flags (x fastest) is set (periodic: wrapped; else clamped), by
+// running counts: linear in the grid size whatever k
+void window_any(std::vector<unsigned char> &v, const int n[3], int axis, int k, bool periodic)
 {
-  std::vector<double> line(n), out(n);
-  for (int r = 0; r < rows; r++) {
-    for (int b = 0; b < n; b++) line[b] = v[r * row_stride + b * stride];
-    for (int b = 0; b < n; b++) {
-      double m = line[b];
-      if (2 * k + 1 >= n) {
-        if (periodic) m = *std::min_element(line.begin(), line.end());
-        else
-          for (int c = std::max(0, b - k); c <= std::min(n - 1, b + k); c++) m = std::min(m, line[c]);
-      } else {
-        for (int d = -k; d <= k; d++) {
-          int c = b + d;
-          if (periodic) c = (c + n) % n;
-          else if (c < 0 || c >= n) continue;
-          m = std::min(m, line[c]);
-        }
-      }
-      out[b] = m;
+  const int len = n[axis];
+  const size_t stride = axis == 0 ? 1 : (axis == 1 ? n[0] : static_cast<size_t>(n[0]) * n[1]);
+  const int o1 = axis == 0 ? n[1] : n[0], o2 = axis == 2 ? n[1] : n[2];
+  const size_t s1 = axis == 0 ? n[0] : 1;
+  const size_t s2 = axis == 2 ? n[0] : static_cast<size_t>(n[0]) * n[1];
+  if (periodic) k = std::min(k, len);    // the whole ring
+  std::vector<int> count(len + 1);
+  for (int b = 0; b < o2; b++)
+    for (int a = 0; a < o1; a++) {
+      const size_t start = a * s1 + b * s2;
+      count[0] = 0;
+      for (int e = 0; e < len; e++) count[e + 1] = count[e] + (v[start + e * stride] ? 1 : 0);
+      auto sum = [&](int from, int to) {    // flags in [from, to], from <= to, within one period
+        if (!periodic) return count[std::min(to, len - 1) + 1] - count[std::max(from, 0)];
+        if (to - from + 1 >= len) return count[len];
+        const int f = ((from % len) + len) % len, t = ((to % len) + len) % len;
+        return f <= t ? count[t + 1] - count[f] : count[len] - count[f] + count[t + 1];
+      };
+      for (int e = 0; e < len; e++) v[start + e * stride] = sum(e - k, e + k) > 0 ? 1 : 0;
     }
-    for (int b = 0; b < n; b++) v[r * row_stride + b * stride] = out[b];
-  }
 }
 }    // namespace
 
@@ -321,10 +320,9 @@ void FixBuryGran::end_of_step()
 }
 
 /* ----------------------------------------------------------------------
-   the group: the awake atoms, the atoms outside the fix group, and the sleepers less than halo
-   below the lowest awake atom of the columns within halo of theirs (columns one largest
-   diameter wide in x and y, as fix sleep/gran's depth rule). Returns whether it changed on any
-   rank.
+   the group: the awake atoms, the atoms outside the fix group, and the sleepers with an awake
+   atom within halo (in x, y and z, on a grid of cells one largest diameter wide in x and y and
+   a quarter of that in z). Returns whether it changed on any rank.
 ------------------------------------------------------------------------- */
 
 bool FixBuryGran::apply_rule()
@@ -338,37 +336,39 @@ bool FixBuryGran::apply_rule()
   double rmax = 0.0, rmax_all = 0.0;
   for (int i = 0; i < nlocal; i++) rmax = MAX(rmax, atom->radius[i]);
   MPI_Allreduce(&rmax, &rmax_all, 1, MPI_DOUBLE, MPI_MAX, world);
+  // cells one largest diameter wide in x and y (the columns of fix sleep/gran's depth rule),
+  // cut into slabs of a quarter of that in z: the rule keeps sleepers up to the cells' sizes
+  // beyond halo, less in z, where the bed is deep
   const double side = rmax_all > 0.0 ? 2.0 * rmax_all : halo;
-  const int nbx = MAX(1, static_cast<int>(domain->xprd / side));
-  const int nby = MAX(1, static_cast<int>(domain->yprd / side));
-  const double wx = domain->xprd / nbx, wy = domain->yprd / nby;
-  const bool px = domain->xperiodic, py = domain->yperiodic;
-  auto column_of = [&](const double *xi) {
-    return column_index(xi[1], domain->boxlo[1], wy, nby, py) * nbx +
-        column_index(xi[0], domain->boxlo[0], wx, nbx, px);
+  const double *prd = domain->prd, *lo = domain->boxlo;
+  const int periodic[3] = {domain->xperiodic, domain->yperiodic, domain->zperiodic};
+  int n[3];
+  double w[3];
+  for (int d = 0; d < 3; d++) {
+    n[d] = MAX(1, static_cast<int>(prd[d] / (d == 2 ? 0.25 * side : side)));
+    w[d] = prd[d] / n[d];
+  }
+  auto cell_of = [&](const double *xi) {
+    size_t c = 0;
+    for (int d = 2; d >= 0; d--) c = c * n[d] + column_index(xi[d], lo[d], w[d], n[d], periodic[d]);
+    return c;
   };
 
-  // lowest awake atom per column, over all ranks
-  const double inf = std::numeric_limits<double>::infinity();
-  std::vector<double> mine(static_cast<size_t>(nbx) * nby, inf), low(mine.size(), inf);
-  for (int i = 0; i < nlocal; i++) {
-    if (asleep[i] != 0.0) continue;
-    double &l = mine[column_of(x[i])];
-    l = MIN(l, x[i][2]);
-  }
-  MPI_Allreduce(mine.data(), low.data(), (int) mine.size(), MPI_DOUBLE, MPI_MIN, world);
+  // the cells holding an awake atom, over all ranks
+  std::vector<unsigned char> mine(static_cast<size_t>(n[0]) * n[1] * n[2], 0), near(mine.size(), 0);
+  for (int i = 0; i < nlocal; i++)
+    if (asleep[i] == 0.0) mine[cell_of(x[i])] = 1;
+  MPI_Allreduce(mine.data(), near.data(), (int) mine.size(), MPI_UNSIGNED_CHAR, MPI_MAX, world);
 
-  // the lowest over the columns within halo in x and y (at least the 8 neighbours), so that an
-  // awake atom within halo of a sleeper is counted in the sleeper's neighbourhood
-  const int kx = MAX(1, static_cast<int>(std::ceil(halo / wx)));
-  const int ky = MAX(1, static_cast<int>(std::ceil(halo / wy)));
-  window_min(low, nbx, 1, nby, nbx, kx, px);
-  window_min(low, nby, nbx, nbx, 1, ky, py);
+  // the cells within halo of such a cell in x, y and z (at least the 26 neighbours): a sleeper
+  // within halo of an awake atom, in each coordinate, is in one of them
+  for (int d = 0; d < 3; d++)
+    window_any(near, n, d, MAX(1, static_cast<int>(std::ceil(halo / w[d]))), periodic[d]);
 
   bigint counts[3] = {0, 0, 0}, all[3] = {0, 0, 0};    // changed, active, buried
   for (int i = 0; i < nlocal; i++) {
     const bool keep =
-        !(mask[i] & groupbit) || asleep[i] == 0.0 || low[column_of(x[i])] - x[i][2] < halo;
+        !(mask[i] & groupbit) || asleep[i] == 0.0 || near[cell_of(x[i])] != 0;
     const bool in = mask[i] & active_bit;
     if (keep != in) {
       counts[0]++;
