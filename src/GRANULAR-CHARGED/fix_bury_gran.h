@@ -24,9 +24,9 @@ namespace LAMMPS_NS {
 
 // Buried sleepers leave LAMMPS's per-atom work (doc/fix_bury_gran.rst). The fix keeps a group
 // (the one of atom_modify first, neigh_modify include and comm_modify group) equal to the awake
-// atoms, the atoms outside the fix group and the sleepers less than `halo` below the lowest
-// awake atom near their column; the other sleepers are buried: LAMMPS does not bin them, list
-// them, send them as ghosts or integrate them. The contact histories of buried pairs are kept
+// atoms, the atoms outside the fix group and the sleepers with an awake atom within `halo`; the
+// other sleepers are buried: LAMMPS does not bin them, list them, send them as ghosts or
+// integrate them. The contact histories of buried pairs are kept
 // per atom by this fix and given back to the pair's fix NEIGH_HISTORY when both atoms rejoin.
 class FixBuryGran : public Fix {
  public:
