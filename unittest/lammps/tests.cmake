@@ -45,3 +45,6 @@ add_dependencies(test_marshall_lanes lmp)
 gc_lammps_test(test_granular_opt_contact_list NP 1 2 SOURCES test_granular_opt_contact_list.cpp)
 # fix tribo/charge against the condenser model's closed forms, charge conservation on 1 and 2 ranks
 gc_lammps_test(test_tribo_charge NP 1 2 SOURCES test_tribo_charge.cpp)
+# fix bury/gran: the same trajectory without the buried sleepers, their contact histories kept,
+# the input checks; on 1 and 2 ranks
+gc_lammps_test(test_bury_gran NP 1 2 SOURCES test_bury_gran.cpp)
