@@ -45,3 +45,6 @@ add_dependencies(test_marshall_lanes lmp)
 gc_lammps_test(test_granular_opt_contact_list NP 1 2 SOURCES test_granular_opt_contact_list.cpp)
 # fix tribo/charge against the condenser model's closed forms, charge conservation on 1 and 2 ranks
 gc_lammps_test(test_tribo_charge NP 1 2 SOURCES test_tribo_charge.cpp)
+# fix sleep/gran pairs awake: granular/opt leaves out the pairs of two sleepers, side by side
+# with pairs all step by step, on 1 and 2 ranks
+gc_lammps_test(test_sleep_pairs NP 1 2 SOURCES test_sleep_pairs.cpp)
