@@ -16,12 +16,14 @@
      the history and contact flag of each pair B left out are those it had before the step, byte
      for byte.
    - WokenPairGoesOnFromItsHistory (wake threshold 1e-7 N: the rain wakes sleepers): the same
-     comparison, with B's history of each pair it left out copied into A after the step. Then A
-     and B must stay the same, bit for bit, also after wakes: B differs from pairs all only
-     through the histories of the pairs it left out, and a woken pair goes on from the history
-     it had when it was last computed (one reset or recomputed fails the comparison). The run
-     wakes sleepers, and pairs all changes the histories of some sleepers' pairs (so the copy
-     is needed; counted).
+     comparison, with B's history of each pair it left out copied into A after the step, and
+     A's atoms woken on the step held (velocity, spin, force, torque zeroed) as pairs awake
+     holds them on their wake step, whose contacts with sleepers it did not compute. Then A and
+     B must stay the same, bit for bit, also after wakes: B differs from pairs all only through
+     the histories of the pairs it left out and the step a woken atom is held, and a woken pair
+     goes on from the history it had when it was last computed (one reset or recomputed fails
+     the comparison). The run wakes sleepers, and pairs all changes the histories of many
+     sleepers' pairs (so the copy is needed; counted).
    - ErrorsNameKeywordAndStyle: pairs awake with pair_style granular, and a bad value.
 
    Checked against broken code: with the pairs of one sleeper left out too (asleep[i] || asleep[j]
