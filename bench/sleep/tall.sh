@@ -42,24 +42,32 @@ for p in $pairs; do
   done
 done
 wait
-# the measured run is the last "Loop time" of each log, and its timer table the last
+# the measured run is the last "Loop time" of each log, and its timer table the last; CPU per
+# step: the wall time times the run's "% CPU use" (on a busy machine a run also waits for a core)
 per_step() { awk '/^Loop time of/ {t=$4; n=$9} END {printf "%.4f", 1e3*t/n}' "$1"; }
+cpu_per_step() {
+  awk '/^Loop time of/ {t=$4; n=$9} /% CPU use with/ {c=$1+0} END {printf "%.4f", 1e3*t*c/100/n}' "$1"
+}
 first=${pairs%% *}
 for p in $pairs; do
-  for c in 1 "$copies"; do echo "$(grep -h '^TALL' "$out/log.$p.$c") ms_per_step $(per_step "$out/log.$p.$c")"; done
+  for c in 1 "$copies"; do
+    echo "$(grep -h '^TALL' "$out/log.$p.$c") ms_per_step $(per_step "$out/log.$p.$c") cpu_ms_per_step $(cpu_per_step "$out/log.$p.$c")"
+  done
   awk -v a="$(per_step "$out/log.$p.1")" -v b="$(per_step "$out/log.$p.$copies")" -v c="$copies" -v p="$p" \
-    'BEGIN {printf "pairs %s: per-step time, %s copies / 1 copy: %.2f\n", p, c, b/a}'
+    -v ca="$(cpu_per_step "$out/log.$p.1")" -v cb="$(cpu_per_step "$out/log.$p.$copies")" \
+    'BEGIN {printf "pairs %s: per-step time, %s copies / 1 copy: %.2f (CPU %.2f)\n", p, c, b/a, cb/ca}'
 done
 for p in $pairs; do
   [[ $p == "$first" ]] && continue
   for c in 1 "$copies"; do
-    awk -v a="$(per_step "$out/log.$first.$c")" -v b="$(per_step "$out/log.$p.$c")" -v c="$c" -v p="$p" -v f="$first" \
-      'BEGIN {printf "%s copies: per-step time, pairs %s / pairs %s: %.2f\n", c, p, f, b/a}'
+    awk -v a="$(per_step "$out/log.$first.$c")" -v b="$(per_step "$out/log.$p.$c")" \
+      -v ca="$(cpu_per_step "$out/log.$first.$c")" -v cb="$(cpu_per_step "$out/log.$p.$c")" -v c="$c" -v p="$p" -v f="$first" \
+      'BEGIN {printf "%s copies: per-step time, pairs %s / pairs %s: %.2f (CPU %.2f)\n", c, p, f, b/a, cb/ca}'
   done
 done
 for p in $pairs; do
   for c in 1 "$copies"; do
-    echo "--- pairs $p, $c copies"
+    echo "--- pairs $p, $c copies: $(grep -h '% CPU use' "$out/log.$p.$c" | tail -1)"
     awk '/^Section/ {n = 0; s = ""} /^Section/, /^Total/ {if (n++ < 12) s = s $0 "\n"} END {printf "%s", s}' \
       "$out/log.$p.$c" | grep -v '^Total'
   done

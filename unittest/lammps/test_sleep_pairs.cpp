@@ -26,12 +26,15 @@
      sleepers' pairs (so the copy is needed; counted).
    - ErrorsNameKeywordAndStyle: pairs awake with pair_style granular, and a bad value.
 
-   Checked against broken code: with the pairs of one sleeper left out too (asleep[i] || asleep[j]
-   in build_contact_list) both comparisons fail at the first step with a sleeper's contact (a
-   rain sphere's force) and the contact counts differ; with the contact list not built again
-   when the sleeping set changes (stale flags: the stamp's generation left out), the counts
-   differ from the first commit after the rain lands and WokenPairGoesOnFromItsHistory fails on
-   the forces after the first wake. */
+   Checked against broken code (each on 1 rank): with the pairs of one sleeper left out too
+   (asleep[i] || asleep[j] in build_contact_list) both side-by-side tests fail at step 101, the
+   first after the bed's commit (84 contacts computed against the 120 counted; atom 73 vx
+   1.01e-15 against 2.34e-15 m/s); with the contact list not built again when the sleeping set
+   changes (the generation left out of its stamp: stale flags) both fail at step 101 (324
+   computed against 120, the histories of pairs of two sleepers changed); with the histories of
+   the pairs left out zeroed, both fail at step 101 (histories changed); with a woken atom not
+   held on its wake step, WokenPairGoesOnFromItsHistory fails at step 265 (atom 68 vz = -g dt / 2:
+   gravity alone, its contacts with sleepers not computed on that step). */
 #include "gc_testing.h"
 
 #include "atom.h"
