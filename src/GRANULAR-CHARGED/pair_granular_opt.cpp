@@ -96,10 +96,16 @@ PairGranularOpt::Sleepers PairGranularOpt::sleepers_to_skip()
   Fix *f = modify->get_fix_by_id(sleep_fix_id);
   if (!f || strcmp(f->style, "sleep/gran") != 0) return s;
   int dim = 0;
+  const auto *on = static_cast<const int *>(f->extract("pairs_awake", dim));
+  if (!on || !*on) return s;
   const auto *generation = static_cast<const bigint *>(f->extract("generation", dim));
   s.asleep = static_cast<const double *>(f->extract("sleeping", dim));
-  if (s.asleep && generation) s.generation = *generation;
-  else s.asleep = nullptr;
+  if (s.asleep && generation) {
+    s.fix = f;
+    s.generation = *generation;
+  } else {
+    s.asleep = nullptr;
+  }
   return s;
 }
 
@@ -203,6 +209,7 @@ bool PairGranularOpt::contact_list_current(const Sleepers &sleepers)
   now.firstvalue = fix_history ? fix_history->firstvalue : nullptr;
   now.build = neighbor->ncalls;
   now.build_step = neighbor->lastcall;
+  now.sleep_fix = sleepers.fix;
   now.sleepers = sleepers.asleep ? sleepers.generation : -1;
   now.inum = list->inum;
   now.nall = nall;

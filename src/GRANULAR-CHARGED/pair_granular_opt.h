@@ -67,6 +67,7 @@ class PairGranularOpt : public PairGranular {
   // fix sleep/gran's state of this step when it leaves out the pairs of two sleepers: its
   // flags (local and ghost atoms) and the generation of its sleeping set
   struct Sleepers {
+    const void *fix = nullptr;
     const double *asleep = nullptr;
     bigint generation = -1;
   };
@@ -103,13 +104,16 @@ class PairGranularOpt : public PairGranular {
     const void *list = nullptr, *ilist = nullptr, *firstneigh = nullptr, *firstflag = nullptr,
                *firstvalue = nullptr;
     bigint build = -1, build_step = -1;
-    bigint sleepers = -1;    // the generation of fix sleep/gran's sleeping set (-1: no skipping)
+    // fix sleep/gran and the generation of its sleeping set (null, -1: no pairs left out)
+    const void *sleep_fix = nullptr;
+    bigint sleepers = -1;
     int inum = -1, nall = -1;
     bool operator==(const ListStamp &o) const
     {
       return list == o.list && ilist == o.ilist && firstneigh == o.firstneigh &&
           firstflag == o.firstflag && firstvalue == o.firstvalue && build == o.build &&
-          build_step == o.build_step && sleepers == o.sleepers && inum == o.inum &&
+          build_step == o.build_step && sleep_fix == o.sleep_fix && sleepers == o.sleepers &&
+          inum == o.inum &&
           nall == o.nall;
     }
   };
