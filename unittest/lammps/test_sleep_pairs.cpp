@@ -15,6 +15,8 @@
      start and the contacts, whose flags are checked against the overlaps) and A's every contact;
      the history and contact flag of each pair B left out are those it had before the step, byte
      for byte.
+   - GenericPathAsWithAllPairs: the same with a model outside the fused set (tangential
+     mindlin), whose pairs granular/opt hands to PairGranular::compute on a list of its own.
    - WokenPairGoesOnFromItsHistory (wake threshold 1e-7 N: the rain wakes sleepers): the same
      comparison, with B's history of each pair it left out copied into A after the step, and
      A's atoms woken on the step held (velocity, spin, force, torque zeroed) as pairs awake
@@ -34,7 +36,9 @@
    computed against 120, the histories of pairs of two sleepers changed); with the histories of
    the pairs left out zeroed, both fail at step 101 (histories changed); with a woken atom not
    held on its wake step, WokenPairGoesOnFromItsHistory fails at step 265 (atom 68 vz = -g dt / 2:
-   gravity alone, its contacts with sleepers not computed on that step). */
+   gravity alone, its contacts with sleepers not computed on that step); with a model outside
+   the fused set run by PairGranular::compute on the whole list (the sleepers' pairs included),
+   GenericPathAsWithAllPairs fails at step 1 (0 contacts counted by the pair against 324). */
 #include "gc_testing.h"
 
 #include "atom.h"
@@ -65,6 +69,9 @@ using LAMMPS_NS::tagint;
 namespace {
 const char *MODEL = "jkr/marshall 2e8 0.7 0.33 0.01 damping marshall tangential marshall 0.3 "
                     "rolling marshall 0.01 twisting marshall/jkr";
+// outside the fused set (tangential mindlin): granular/opt runs PairGranular::compute on its
+// generic list
+const char *GENERIC = "jkr/marshall 2e8 0.7 0.33 0.01 damping marshall tangential mindlin NULL 1.0 0.3";
 constexpr double A = 1.995e-6;    // lattice spacing, below the diameter: neighbours touch
 constexpr int NBED = 6 * 6 * 3, NRAIN = 40;
 constexpr int NSTEPS = 2400;      // the rain lands from step ~400 to ~2000
@@ -74,7 +81,8 @@ constexpr double RADSUM = 2.0e-6;
 const double DELTA_C = gctest::JKR{0.5e-6, 2e8 / (2.0 * (1.0 - 0.33 * 0.33)), 0.01}.deltaC();
 
 // the deck with `pairs` all or awake and wake threshold `wake` (N)
-std::vector<std::string> deck(const std::string &newton, const std::string &pairs, double wake)
+std::vector<std::string> deck(const std::string &newton, const std::string &pairs, double wake,
+                              const std::string &model)
 {
   return {"units si", "atom_style sphere", "atom_modify map array sort 0 0", "boundary p p f",
           "newton " + newton, fmt::format("lattice sc {}", A), "region box block 0 6 0 6 -1 20",
@@ -85,8 +93,8 @@ std::vector<std::string> deck(const std::string &newton, const std::string &pair
           "set group all diameter 2.0e-6", "set group all density 2500",
           "group rain subtract all bed", "velocity rain create 1e7 77 loop geom",
           "velocity rain set NULL NULL -1.0 sum yes units box", "pair_style granular/opt",
-          std::string("pair_coeff * * ") + MODEL,
-          std::string("fix floor all wall/gran/opt granular ") + MODEL + " zplane -0.999e-6 NULL",
+          "pair_coeff * * " + model,
+          "fix floor all wall/gran/opt granular " + model + " zplane -0.999e-6 NULL",
           "comm_modify vel yes", "neighbor 2e-7 bin", "neigh_modify every 1 delay 0 check yes",
           "fix integrate all nve/sphere", "fix grav all gravity 9.81 vector 0 0 -1",
           "timestep 5e-9", "thermo 0",
@@ -223,11 +231,12 @@ struct Findings {
 
 // A (pairs all) and B (pairs awake) side by side, step by step; with copy_history, B's flag and
 // history of each pair it left out are copied into A after the step
-Findings side_by_side(const std::string &newton, double wake, bool copy_history)
+Findings side_by_side(const std::string &newton, double wake, bool copy_history,
+                      const std::string &model = MODEL)
 {
   Lmp a, b;
-  a.cmds(deck(newton, "all", wake));
-  b.cmds(deck(newton, "awake", wake));
+  a.cmds(deck(newton, "all", wake, model));
+  b.cmds(deck(newton, "awake", wake, model));
   Findings found;
   const int n = static_cast<int>(a.lmp->atom->natoms);
   for (int step = 1; step <= NSTEPS; step++) {
@@ -241,8 +250,10 @@ Findings side_by_side(const std::string &newton, double wake, bool copy_history)
     // B's pair left out exactly the contacts of two sleepers; A's computed all
     const Contacts cb = count_contacts(b, asleep, step);
     EXPECT_EQ(contacts_computed(b), cb.computed) << "step " << step << ": pairs awake";
-    EXPECT_EQ(contacts_computed(a), cb.computed + cb.of_sleepers) << "step " << step
-                                                                  << ": pairs all";
+    // (with no model fused, pairs all runs PairGranular::compute alone, which counts nothing)
+    if (model == MODEL)
+      EXPECT_EQ(contacts_computed(a), cb.computed + cb.of_sleepers) << "step " << step
+                                                                    << ": pairs all";
     found.sleeper_contacts += cb.of_sleepers;
 
     // the pairs B left out: flag and history as before the step, byte for byte
@@ -327,6 +338,18 @@ TEST(SleepPairs, AwakeAtomsAsWithAllPairs)
     EXPECT_GE(f.fallen, NBED + 20.0) << "newton " << newton << ": the rain falls asleep too";
     EXPECT_GT(f.sleeper_contacts, 0) << "newton " << newton << ": contacts left out";
     EXPECT_GT(f.frozen_compared, 0) << "newton " << newton;
+  }
+}
+
+// the same with a model outside the fused set: the pairs of two sleepers left out of the list
+// PairGranular::compute runs on
+TEST(SleepPairs, GenericPathAsWithAllPairs)
+{
+  for (const std::string newton : {"off", "on"}) {
+    const Findings f = side_by_side(newton, 1.0, false, GENERIC);
+    EXPECT_EQ(f.woken, 0.0) << "newton " << newton << ": nothing wakes";
+    EXPECT_GE(f.fallen, NBED + 5.0) << "newton " << newton << ": some of the rain falls asleep";
+    EXPECT_GT(f.sleeper_contacts, 0) << "newton " << newton << ": contacts left out";
   }
 }
 
