@@ -45,8 +45,8 @@ enum VectorElement { V_AWAKE, V_SLEEPING, V_FALLEN_ASLEEP, V_WOKEN, V_NELEMENTS 
 FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), speed_sleep(-1.0), force_sleep(-1.0), force_wake(-1.0), rest_time(-1.0),
     depth(0.0), every(100), rest_steps_needed(0), rest_rule(true), pairs_awake(0), asleep(nullptr),
-    pushed(nullptr),
-    rest_steps(nullptr), push(nullptr), wake_mark(nullptr), ncontact(nullptr), comm_mode(COMM_FLAGS),
+    pushed(nullptr), rest_steps(nullptr), push(nullptr), wake_mark(nullptr), ncontact(nullptr),
+    comm_mode(COMM_FLAGS),
     set_generation(0), fallen_asleep_total(0), woken_total(0), pair_history(nullptr),
     active_build(-1), active_generation(-1)
 {
