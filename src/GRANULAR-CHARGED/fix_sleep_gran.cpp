@@ -44,8 +44,9 @@ enum VectorElement { V_AWAKE, V_SLEEPING, V_FALLEN_ASLEEP, V_WOKEN, V_NELEMENTS 
 
 FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
     Fix(lmp, narg, arg), speed_sleep(-1.0), force_sleep(-1.0), force_wake(-1.0), rest_time(-1.0),
-    depth(0.0), every(100), rest_steps_needed(0), rest_rule(true), asleep(nullptr), pushed(nullptr),
-    rest_steps(nullptr), push(nullptr), wake_mark(nullptr), ncontact(nullptr), comm_mode(COMM_FLAGS),
+    depth(0.0), every(100), rest_steps_needed(0), rest_rule(true), pairs_awake(0), asleep(nullptr),
+    pushed(nullptr), rest_steps(nullptr), push(nullptr), wake_mark(nullptr), ncontact(nullptr),
+    comm_mode(COMM_FLAGS),
     set_generation(0), fallen_asleep_total(0), woken_total(0), pair_history(nullptr),
     active_build(-1), active_generation(-1)
 {
@@ -86,6 +87,15 @@ FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
       iarg += 2;
     } else if (strcmp(arg[iarg], "depth") == 0) {
       depth = positive("depth");
+    } else if (strcmp(arg[iarg], "pairs") == 0) {
+      if (iarg + 2 > narg) utils::missing_cmd_args(FLERR, "fix sleep/gran pairs", error);
+      if (strcmp(arg[iarg + 1], "all") == 0)
+        pairs_awake = 0;
+      else if (strcmp(arg[iarg + 1], "awake") == 0)
+        pairs_awake = 1;
+      else
+        error->all(FLERR, "Fix {} pairs must be all or awake, got {}", style, arg[iarg + 1]);
+      iarg += 2;
     } else {
       error->all(FLERR, "Unknown fix {} keyword {}", style, arg[iarg]);
     }
@@ -150,6 +160,13 @@ void FixSleepGran::init()
                force->pair_style ? force->pair_style : "none");
   if (modify->get_fix_by_style("^sleep/gran$").size() > 1)
     error->all(FLERR, "Only one fix sleep/gran may be defined");
+  // only granular/opt leaves out the pairs of two sleepers: with any other style the keyword
+  // would change nothing, and -sf opt would silently give another trajectory than the plain style
+  if (pairs_awake && !force->pair_match("granular/opt", 1))
+    error->all(FLERR,
+               "Fix {} pairs awake requires pair_style granular/opt (or -sf opt), not {}: pair "
+               "style {} computes every pair; use pairs all",
+               style, force->pair_style, force->pair_style);
   // the pair style's contact flags, if its models keep a history (fix neigh/history)
   auto histories = modify->get_fix_by_style("^NEIGH_HISTORY$");
   if (histories.size() > 1)
@@ -207,7 +224,7 @@ void FixSleepGran::setup_pre_force(int /*vflag*/)
 
 void FixSleepGran::setup(int /*vflag*/)
 {
-  hold_sleepers();
+  hold_sleepers(false);
 }
 
 /* ----------------------------------------------------------------------
@@ -262,7 +279,10 @@ void FixSleepGran::post_force(int /*vflag*/)
     exchange_flags();
     set_generation++;
   }
-  hold_sleepers();
+  // with pairs awake the contacts of the sleepers woken now with other sleepers were not
+  // computed on this step: their forces are incomplete, so they are held this step too and
+  // move from the next, with all their contacts computed
+  hold_sleepers(pairs_awake != 0);
 }
 
 /* ----------------------------------------------------------------------
@@ -515,14 +535,15 @@ void FixSleepGran::surface_heights(std::vector<double> &top, int &nbx, int &nby)
 }
 
 /* ----------------------------------------------------------------------
-   a sleeper stays where it is: the integrator sees zero velocity, spin, force and torque
+   a sleeper stays where it is: the integrator sees zero velocity, spin, force and torque; so
+   does, with woken_too, an atom woken on this step (wake_mark, set by wake_pushed())
 ------------------------------------------------------------------------- */
 
-void FixSleepGran::hold_sleepers()
+void FixSleepGran::hold_sleepers(bool woken_too)
 {
   double **v = atom->v, **w = atom->omega, **f = atom->f, **t = atom->torque;
   for (int i = 0; i < atom->nlocal; i++) {
-    if (asleep[i] == 0.0) continue;
+    if (asleep[i] == 0.0 && !(woken_too && wake_mark[i] != 0.0)) continue;
     v[i][0] = v[i][1] = v[i][2] = 0.0;
     w[i][0] = w[i][1] = w[i][2] = 0.0;
     f[i][0] = f[i][1] = f[i][2] = 0.0;
@@ -597,6 +618,10 @@ void *FixSleepGran::extract(const char *name, int &dim)
   if (strcmp(name, "contacts") == 0) {
     dim = 1;
     return ncontact;
+  }
+  if (strcmp(name, "pairs_awake") == 0) {
+    dim = 0;
+    return &pairs_awake;
   }
   return nullptr;
 }

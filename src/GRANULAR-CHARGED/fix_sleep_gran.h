@@ -26,7 +26,9 @@ namespace LAMMPS_NS {
 // been at rest (speed, surface spin speed and net force below thresholds) for a stated time, and
 // optionally lies deep enough below the local bed surface, sleeps: velocity, spin, force and
 // torque are held at zero after the forces, so the integrator leaves it in place. The pair style
-// computes every contact as it does without this fix. A sleeper wakes, with the sleepers
+// computes every contact as it does without this fix (keyword pairs all), or, with pairs awake
+// (granular/opt only), every contact but those of two sleepers, whose histories it leaves as
+// they are. A sleeper wakes, with the sleepers
 // touching it, when the contact force from its awake partners exceeds the wake threshold. Falling
 // asleep is committed every `every` steps, waking on the step.
 //
@@ -73,12 +75,15 @@ class FixSleepGran : public Fix {
   // "contacts" (dim 1): per atom (local and ghost), contacts computed this step (zeroed in
   //   pre_force, counted in post_force; pairs of two sleepers not counted); only an atom that
   //   touches another can fall asleep
+  // "pairs_awake" (dim 0, int): 1 with keyword pairs awake (the pair style leaves out the pairs
+  //   of two sleepers, by the flags of "sleeping"), 0 with pairs all
   void *extract(const char *, int &) override;
 
  private:
   double speed_sleep, force_sleep, force_wake, rest_time, depth;
   int every, rest_steps_needed;
   bool rest_rule;    // time none: only the depth rule
+  int pairs_awake;   // keyword pairs: 1 awake (granular/opt skips the pairs of two sleepers), 0 all
 
   double *asleep;        // 1.0 sleeping, 0.0 awake (local + ghost)
   double *pushed;        // 1.0 for a sleeper pushed beyond wake on this step (local + ghost)
@@ -107,7 +112,7 @@ class FixSleepGran : public Fix {
   bool at_rest(int i) const;
   void fall_asleep();
   void wake_pushed();
-  void hold_sleepers();
+  void hold_sleepers(bool woken_too);
   void surface_heights(std::vector<double> &top, int &nbx, int &nby) const;
   int column_of(const double *x, int nbx, int nby) const;
   void check_fix_order();

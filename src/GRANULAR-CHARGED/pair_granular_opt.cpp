@@ -74,6 +74,39 @@ void PairGranularOpt::init_style()
   fused_ready = false;    // init_one() may still mix new models: set up before the first compute
   list_stale = true;      // models, groups or special factors may have changed
   FixChargeCheck::ensure(lmp);    // charges without a Coulomb solver: warned at init
+  // fix sleep/gran with pairs awake: the pairs of two sleepers are left out
+  sleep_fix_id.clear();
+  for (auto *f : modify->get_fix_by_style("^sleep/gran$")) {
+    int dim = 0;
+    const auto *on = static_cast<const int *>(f->extract("pairs_awake", dim));
+    if (on && *on) sleep_fix_id = f->id;
+  }
+}
+
+/* ----------------------------------------------------------------------
+   the sleeping flags (local and ghost atoms, current from fix sleep/gran's pre_force on) and
+   the generation of the sleeping set when fix sleep/gran leaves out the pairs of two sleepers;
+   no flags otherwise. The flags are read anew each step: the fix reallocates them as atoms come.
+------------------------------------------------------------------------- */
+
+PairGranularOpt::Sleepers PairGranularOpt::sleepers_to_skip()
+{
+  Sleepers s;
+  if (sleep_fix_id.empty()) return s;
+  Fix *f = modify->get_fix_by_id(sleep_fix_id);
+  if (!f || strcmp(f->style, "sleep/gran") != 0) return s;
+  int dim = 0;
+  const auto *on = static_cast<const int *>(f->extract("pairs_awake", dim));
+  if (!on || !*on) return s;
+  const auto *generation = static_cast<const bigint *>(f->extract("generation", dim));
+  s.asleep = static_cast<const double *>(f->extract("sleeping", dim));
+  if (s.asleep && generation) {
+    s.fix = f;
+    s.generation = *generation;
+  } else {
+    s.asleep = nullptr;
+  }
+  return s;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -121,19 +154,24 @@ void PairGranularOpt::setup_fused()
    same order of operations, skipping what the set does not use (relative tangential speed,
    heat, classic torque scaling). The history of a pair is the same array at the same offsets,
    so fix neigh/history, restarts and single() see no difference. Every pair of the list is
-   computed, as by PairGranular, whatever fixes hold its atoms (fix freeze, fix sleep/gran).
+   computed, as by PairGranular, whatever fixes hold its atoms (fix freeze, fix sleep/gran),
+   except with fix sleep/gran ... pairs awake: the pairs of two sleepers are then left out of the
+   contact list (no force, torque or virial; contact flag and history left as they are), which
+   is built again whenever the sleeping set may have changed.
 ------------------------------------------------------------------------- */
 
 void PairGranularOpt::compute(int eflag, int vflag)
 {
   if (!fused_ready) setup_fused();
-  // nothing to fuse, a heat model or rigid-body masses: the sub-model path does it all
-  if (generic_only || fix_rigid) {
+  const Sleepers sleepers = sleepers_to_skip();
+  // nothing to fuse, a heat model or rigid-body masses: the sub-model path does it all (on the
+  // generic list of the pairs not of two sleepers, when those are left out)
+  if ((generic_only || fix_rigid) && !sleepers.asleep) {
     PairGranular::compute(eflag, vflag);
     return;
   }
   begin_step(eflag, vflag);
-  if (!contact_list_current()) build_contact_list();
+  if (!contact_list_current(sleepers)) build_contact_list(sleepers.asleep);
   // the pairs outside the fused set first: their forces are summed before the fused contacts'
   const bigint generic_contacts = generic_i.empty() ? 0 : compute_generic_pairs(eflag, vflag);
   const bigint fused_contacts = compute_fused_contacts();
@@ -156,20 +194,23 @@ void PairGranularOpt::begin_step(int eflag, int vflag)
    is the contact list the one of this neighbor list, with the radii and types it was built
    from? A build of the neighbor list (neighbor->ago == 0, or another build count or list),
    another number of atoms, init_style() or any atom's new radius (fix adapt, set) or type
-   makes it stale.
+   makes it stale, and so does a new generation of the sleeping set when the pairs of two
+   sleepers are left out.
 ------------------------------------------------------------------------- */
 
-bool PairGranularOpt::contact_list_current()
+bool PairGranularOpt::contact_list_current(const Sleepers &sleepers)
 {
   const int nall = atom->nlocal + atom->nghost;
   ListStamp now;
   now.list = list;
   now.ilist = list->ilist;
   now.firstneigh = list->firstneigh;
-  now.firstflag = fix_history->firstflag;
-  now.firstvalue = fix_history->firstvalue;
+  now.firstflag = fix_history ? fix_history->firstflag : nullptr;
+  now.firstvalue = fix_history ? fix_history->firstvalue : nullptr;
   now.build = neighbor->ncalls;
   now.build_step = neighbor->lastcall;
+  now.sleep_fix = sleepers.fix;
+  now.sleepers = sleepers.asleep ? sleepers.generation : -1;
   now.inum = list->inum;
   now.nall = nall;
   const bool current = !list_stale && neighbor->ago != 0 && now == list_stamp &&
@@ -233,33 +274,40 @@ inline int PairGranularOpt::scales_of(int i, int j, const FusedMarshall &fm)
 /* ----------------------------------------------------------------------
    the contact list from the neighbor list, in list order: each pair of a fused model (with
    its R_eff and scales, special factor, contact flag and history in fix neigh/history's pages),
-   and the pairs of other models for the generic list; the radii and types it was built from
+   and the pairs of other models for the generic list (all pairs when no model is fused, a heat
+   model or rigid bodies); the radii and types it was built from. With sleeping flags (fix
+   sleep/gran ... pairs awake) the pairs of two sleepers are left out: a ghost's flag is its
+   owner's, so every rank that holds a pair decides alike.
 ------------------------------------------------------------------------- */
 
-void PairGranularOpt::build_contact_list()
+void PairGranularOpt::build_contact_list(const double *asleep)
 {
   const int nall = atom->nlocal + atom->nghost;
   const int *type = atom->type;
   const double *radius = atom->radius;
   const double *special_lj = force->special_lj;
   const int size_hist = get_size_history();
+  const bool all_generic = generic_only || fix_rigid;
   type_scales();
   candidates.clear();
   generic_i.clear();
   generic_jj.clear();
   for (int ii = 0; ii < list->inum; ii++) {
     const int i = list->ilist[ii];
-    int *touch = fix_history->firstflag[i];
-    double *allhistory = fix_history->firstvalue[i];
+    // no history: generic pairs only (a fused model keeps one)
+    int *touch = fix_history ? fix_history->firstflag[i] : nullptr;
+    double *allhistory = fix_history ? fix_history->firstvalue[i] : nullptr;
     const int *jlist = list->firstneigh[i];
     const int jnum = list->numneigh[i];
+    const bool i_asleep = asleep && asleep[i] != 0.0;
     for (int jj = 0; jj < jnum; jj++) {
       const int j = jlist[jj] & NEIGHMASK;
       const double factor_lj = special_lj[sbmask(jlist[jj])];
       if (factor_lj == 0) continue;
+      if (i_asleep && asleep[j] != 0.0) continue;
       const int model = types_indices[type[i]][type[j]];
       const FusedMarshall &fm = fused[model];
-      if (!fm.on) {
+      if (all_generic || !fm.on) {
         generic_i.push_back(i);
         generic_jj.push_back(jj);
         continue;

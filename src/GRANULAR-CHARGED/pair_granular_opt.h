@@ -22,6 +22,7 @@ PairStyle(granular/opt,PairGranularOpt);
 #include "pair_granular.h"
 
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace LAMMPS_NS {
@@ -32,7 +33,8 @@ namespace LAMMPS_NS {
 // time by the inline equations of marshall_kernels.h (marshall_lanes.h), no virtual calls.
 // Every other type pair runs PairGranular::compute on a list of those pairs only. Same
 // pair_coeff syntax, history layout, restart and single() as granular
-// (doc/pair_granular_jkr_marshall.rst, "pair_style granular/opt").
+// (doc/pair_granular_jkr_marshall.rst, "pair_style granular/opt"). With fix sleep/gran ...
+// pairs awake, the pairs of two sleepers are left out of the contact list (doc/fix_sleep_gran.rst).
 class PairGranularOpt : public PairGranular {
  public:
   PairGranularOpt(class LAMMPS *);
@@ -59,6 +61,16 @@ class PairGranularOpt : public PairGranular {
   bool any_heat;                         // a model with heat conduction
   bigint ncontacts;
   bool history_update;                   // this compute() advances the contact histories
+  // the ID of fix sleep/gran with pairs awake ("": none, or pairs all), found by init_style()
+  // and looked up by ID each step (a fix deleted or replaced before a run without init)
+  std::string sleep_fix_id;
+  // fix sleep/gran's state of this step when it leaves out the pairs of two sleepers: its
+  // flags (local and ghost atoms) and the generation of its sleeping set
+  struct Sleepers {
+    const void *fix = nullptr;
+    const double *asleep = nullptr;
+    bigint generation = -1;
+  };
   int hist_tangential, hist_rolling, hist_twisting;    // offsets in the per-pair history
 
   // R_eff and the JKR scales of one pair (of a type pair whose atoms all have one radius each)
@@ -92,12 +104,17 @@ class PairGranularOpt : public PairGranular {
     const void *list = nullptr, *ilist = nullptr, *firstneigh = nullptr, *firstflag = nullptr,
                *firstvalue = nullptr;
     bigint build = -1, build_step = -1;
+    // fix sleep/gran and the generation of its sleeping set (null, -1: no pairs left out)
+    const void *sleep_fix = nullptr;
+    bigint sleepers = -1;
     int inum = -1, nall = -1;
     bool operator==(const ListStamp &o) const
     {
       return list == o.list && ilist == o.ilist && firstneigh == o.firstneigh &&
           firstflag == o.firstflag && firstvalue == o.firstvalue && build == o.build &&
-          build_step == o.build_step && inum == o.inum && nall == o.nall;
+          build_step == o.build_step && sleep_fix == o.sleep_fix && sleepers == o.sleepers &&
+          inum == o.inum &&
+          nall == o.nall;
     }
   };
   ListStamp list_stamp;
@@ -133,8 +150,9 @@ class PairGranularOpt : public PairGranular {
   void setup_fused();
   // the steps of compute()
   void begin_step(int eflag, int vflag);
-  bool contact_list_current();
-  void build_contact_list();
+  Sleepers sleepers_to_skip();
+  bool contact_list_current(const Sleepers &sleepers);
+  void build_contact_list(const double *asleep);
   void type_scales();
   bigint compute_generic_pairs(int eflag, int vflag);
   void build_generic_list();

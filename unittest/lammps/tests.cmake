@@ -48,3 +48,6 @@ gc_lammps_test(test_tribo_charge NP 1 2 SOURCES test_tribo_charge.cpp)
 # fix bury/gran: the same trajectory without the buried sleepers, their contact histories kept,
 # the input checks; on 1 and 2 ranks
 gc_lammps_test(test_bury_gran NP 1 2 SOURCES test_bury_gran.cpp)
+# fix sleep/gran pairs awake: granular/opt leaves out the pairs of two sleepers, side by side
+# with pairs all step by step, on 1 and 2 ranks
+gc_lammps_test(test_sleep_pairs NP 1 2 SOURCES test_sleep_pairs.cpp)
