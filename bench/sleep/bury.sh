@@ -10,30 +10,8 @@ run=$(cd "$1" && pwd); build=$(cd "${2:-$here/../../build}" && pwd)
 copies=${COPIES:-10}; steps=${STEPS:-5000}; warmup=${WARMUP:-4000}
 export LD_LIBRARY_PATH="$build${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 out=$(mktemp -d)
-# the data file of `c` copies of the final packing (final.dump: id type x y z radius q), each copy
-# 2 r_p above the top of the one below, with 40 r_p of room above the top (as tall.sh)
-stack() {
-  /usr/bin/python3 - "$run/final.dump" "$1" "$2" <<'PY'
-import sys, numpy as np
-dump, copies, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
-with open(dump) as f:
-    lines = f.readlines()
-box = [list(map(float, lines[5 + k].split()[:2])) for k in range(3)]
-a = np.loadtxt(lines[9:], ndmin=2)
-rp = a[:, 5].max()
-dz = a[:, 4].max() + 2.0 * rp
-rows = []
-for c in range(copies):
-    for r in a:
-        rows.append((len(rows) + 1, int(r[1]), r[2], r[3], r[4] + c * dz, 2.0 * r[5], 2500.0, r[6]))
-ztop = max(r[4] for r in rows) + 40.0 * rp
-with open(out, "w") as f:
-    f.write(f"stacked bed: {copies} copies of {dump}\n\n{len(rows)} atoms\n1 atom types\n\n")
-    f.write(f"{box[0][0]!r} {box[0][1]!r} xlo xhi\n{box[1][0]!r} {box[1][1]!r} ylo yhi\n0.0 {ztop!r} zlo zhi\n\nAtoms # hybrid\n\n")
-    for r in rows:
-        f.write("%d %d %.12g %.12g %.12g %.12g %.12g %.12g\n" % r)
-PY
-}
+# the data file of `c` copies of the final packing, stacked in z (stack_bed.py)
+stack() { /usr/bin/python3 "$here/stack_bed.py" "$run/final.dump" "$1" "$2"; }
 for c in 1 "$copies"; do
   stack "$c" "$out/tall.$c.data"
   for b in no yes; do
