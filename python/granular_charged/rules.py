@@ -153,7 +153,7 @@ def _table() -> list:
           W("inject", ("auto", "rain", "plane", "sequential")),
           W("farfield", ("exact", "average", "none")),
           W("coul_extrapolate", YESNO), W("coul_solver", ("replicated", "distributed")),
-          W("electrode", YESNO), W("sleep", ("yes", "no", "auto")), W("split_log", YESNO), W("resume", YESNO), W("pair_opt", YESNO),
+          W("electrode", YESNO), W("sleep", ("yes", "no", "auto")), W("sleep_bury", YESNO), W("split_log", YESNO), W("resume", YESNO), W("pair_opt", YESNO),
           W("damping_model", ("marshall", "marshall/printed")),
           W("rolling_model", ("marshall", "marshall/particle")),
           N("U0", "v_@ > 0", "finite and > 0 [m/s] (the time step and the injection interval divide by it)"),
