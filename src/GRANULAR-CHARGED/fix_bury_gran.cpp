@@ -18,6 +18,7 @@
 #include "group.h"
 #include "modify.h"
 #include "my_page.h"
+#include "neigh_history_arrays.h"
 #include "neighbor.h"
 #include "update.h"
 
@@ -35,47 +36,11 @@ namespace {
 // the elements of the global vector (compute_vector's index)
 enum VectorElement { V_ACTIVE, V_BURIED, V_RECOMPUTES, V_FORCED, V_NELEMENTS };
 
-// The per-atom partner arrays of fix NEIGH_HISTORY (its pre_exchange() fills them from the
-// neighbor list, its post_neighbor() copies them into the new list). LAMMPS 4Jul2026 gives them
-// through public accessors; 4Feb2025 keeps them protected with no accessor, and there a class
-// derived from it forms pointers to those members (as fix tribo/charge reads fix wall/gran).
-struct HistoryArrays {
-  int *npartner;
-  tagint **partner;
-  double **valuepartner;
-  MyPage<tagint> *ipage;
-  MyPage<double> *dpage;
-  int dnum;
-};
-
-template <class F, class = void> struct HasHistoryAccessors : std::false_type {};
-template <class F>
-struct HasHistoryAccessors<F, std::void_t<decltype(std::declval<F &>().get_dpage_atom())>>
-    : std::true_type {};
-
-struct NeighHistoryMembers : public FixNeighHistory {
-  static HistoryArrays of(FixNeighHistory *f)
-  {
-    return {f->*(&NeighHistoryMembers::npartner), f->*(&NeighHistoryMembers::partner),
-            f->*(&NeighHistoryMembers::valuepartner), f->*(&NeighHistoryMembers::ipage_atom),
-            f->*(&NeighHistoryMembers::dpage_atom), f->*(&NeighHistoryMembers::dnum)};
-  }
-};
-
 // LAMMPS keeps the group of comm_modify group protected in Comm with no accessor: read it
 // through a pointer to the member formed in a derived class
 struct CommBorderGroup : public Comm {
   static int of(const Comm *c) { return c->*(&CommBorderGroup::bordergroup); }
 };
-
-template <class F> HistoryArrays history_arrays(F *f)
-{
-  if constexpr (HasHistoryAccessors<F>::value)
-    return {f->get_npartner(), f->get_partner(), f->get_valuepartner(), f->get_ipage_atom(),
-            f->get_dpage_atom(), f->get_dnum()};
-  else
-    return NeighHistoryMembers::of(f);
-}
 
 // index of the column (n columns of width w from lo) holding coordinate c, periodic or clamped
 int column_index(double c, double lo, double w, int n, bool periodic)
@@ -223,7 +188,7 @@ void FixBuryGran::init()
   if (histories.size() > 1)
     error->all(FLERR, "Fix {} needs a single granular pair style with one contact history", style);
   history = histories.empty() ? nullptr : dynamic_cast<FixNeighHistory *>(histories.front());
-  dnum = history ? history_arrays(history).dnum : 0;
+  dnum = history ? neigh_history_arrays(history).dnum : 0;
   if (restart_dnum >= 0 && history && restart_dnum != dnum)
     error->all(FLERR, "Fix {}: the kept contact histories of the restart have {} values per contact, "
                "the pair style's {}", style, restart_dnum, dnum);
@@ -394,7 +359,7 @@ bool FixBuryGran::apply_rule()
 void FixBuryGran::keep_and_restore_histories()
 {
   if (!history) return;
-  HistoryArrays h = history_arrays(history);
+  NeighHistoryArrays h = neigh_history_arrays(history);
   const int nlocal = atom->nlocal;
   const int nall = nlocal + atom->nghost;
   int *mask = atom->mask;

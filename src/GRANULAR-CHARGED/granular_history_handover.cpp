@@ -14,6 +14,7 @@
 #include "error.h"
 #include "fix_neigh_history.h"
 #include "modify.h"
+#include "neigh_history_arrays.h"
 #include "pair.h"
 #include "update.h"
 #include "utils.h"
@@ -25,8 +26,8 @@
 using namespace LAMMPS_NS;
 
 /* ----------------------------------------------------------------------
-   Modify keeps the stored entries of a restart file in protected members, FixNeighHistory its
-   partner counts: a derived class may form pointers to them
+   Modify keeps the stored entries of a restart file in protected members: a derived class may
+   form pointers to them
 ------------------------------------------------------------------------- */
 
 namespace {
@@ -34,10 +35,6 @@ struct StoredFixData : Modify {
   static char **Modify::*ids() { return &StoredFixData::id_restart_peratom; }
   static char **Modify::*styles() { return &StoredFixData::style_restart_peratom; }
   static int *Modify::*used() { return &StoredFixData::used_restart_peratom; }
-};
-// the number of contacts (partners) a history holds for each local atom after a run
-struct HistoryPartners : FixNeighHistory {
-  static int *FixNeighHistory::*count() { return &HistoryPartners::npartner; }
 };
 
 // the stored histories of pair styles granular and granular/opt no fix has taken
@@ -66,7 +63,8 @@ bool restored_from_restart(Modify *modify, const char *id)
 
 bigint history_contacts(LAMMPS *lmp, FixNeighHistory *history)
 {
-  const int *count = history->*HistoryPartners::count();
+  // the number of contacts (partners) the history holds for each local atom after a run
+  const int *count = neigh_history_arrays(history).npartner;
   bigint mine = 0;
   for (int i = 0; count && i < lmp->atom->nlocal; i++) mine += count[i];
   bigint all = 0;
