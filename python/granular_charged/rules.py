@@ -568,8 +568,10 @@ def sleep_auto(given: dict, defaults: dict | None = None) -> dict:
     deckfile.deck_variables when None): {'sleep': yes or no, the setting the run uses;
     'height_rp': the bed's expected height N <4/3 pi r^3> / (SLEEP_AUTO_PHI L^2) in r_p, <r^3>
     over the species weighted by their number fractions; 'threshold_rp': sleep_auto
-    sleep_depth}. sleep yes and no are themselves; auto is yes when the height exceeds the
-    threshold. The values must pass the input rules (problems)."""
+    sleep_depth; 'epd': whether E0, eps_p or electrode is set}. sleep yes and no are
+    themselves; auto is yes when the height exceeds the threshold and no EPD keyword is set
+    (fix coul/fmm would need sleepers full with them, whose packing has not been measured).
+    The values must pass the input rules (problems)."""
     if defaults is None:
         from .run.deckfile import deck_variables
         defaults = deck_variables("in.deposition")
@@ -580,10 +582,12 @@ def sleep_auto(given: dict, defaults: dict | None = None) -> dict:
     rp, L = vals.number("rp"), vals.number("L_rp") * vals.number("rp")
     height = vals.number("N") * 4.0 / 3.0 * math.pi * m3 / (SLEEP_AUTO_PHI * L * L) / rp
     threshold = vals.number("sleep_auto") * vals.number("sleep_depth")
+    epd = (vals.number("E0") != 0 or vals.number("eps_p") > 0
+           or vals.text["electrode"] == "yes")
     sleep = vals.text["sleep"]
     if sleep == "auto":
-        sleep = "yes" if height > threshold else "no"
-    return {"sleep": sleep, "height_rp": height, "threshold_rp": threshold}
+        sleep = "yes" if height > threshold and not epd else "no"
+    return {"sleep": sleep, "height_rp": height, "threshold_rp": threshold, "epd": epd}
 
 
 # ---- the deck: the generated checking block -----------------------------------------------

@@ -86,6 +86,24 @@ def test_auto_is_on_for_a_tall_bed(build_dir, tmp_path):
                                   "sleeping on (depth 15 r_p)"], _sleep_lines(auto)
 
 
+@pytest.mark.parametrize("epd", [{"E0": "1e5"}, {"eps_p": "3.8"}, {"electrode": "yes"}])
+def test_auto_stays_off_with_an_epd_keyword(build_dir, tmp_path, epd):
+    """A tall bed with an EPD keyword: fix coul/fmm would need sleepers full with sleepers
+    (whose packing has not been measured), so auto runs the commands of sleep no and says why;
+    Python chooses the same."""
+    (tmp_path / "a").mkdir(), (tmp_path / "n").mkdir()
+    v = dict(TALL, **epd)
+    auto = _setup_log(build_dir, tmp_path / "a", dict(v, sleep="auto"))
+    no = _setup_log(build_dir, tmp_path / "n", dict(v, sleep="no"))
+    assert _commands(auto) == _commands(no)
+    assert not any("sleep/gran" in c for c in _commands(auto))
+    assert _sleep_lines(auto) == ["GC SLEEP auto: expected bed height 167 r_p > 45 r_p, but E0, "
+                                  "eps_p or electrode is set: sleeping off"], _sleep_lines(auto)
+    py = rules.sleep_auto(dict(v, sleep="auto"))
+    assert py["sleep"] == "no" and py["epd"]
+    assert not rules.sleep_auto(dict(TALL, sleep="auto"))["epd"]
+
+
 @pytest.mark.parametrize("asked, same_as, extra", [
     ("auto", "no", {}),                          # 4.1 r_p <= 45 r_p: off
     ("auto", "yes", {"sleep_auto": "0.2"}),      # 4.1 r_p > 3 r_p: on
