@@ -65,6 +65,25 @@ def test_var_refuses_what_the_runner_sets(tmp_path):
     refused(gc(["conventions", "--var", "L_rp", "14"], tmp_path), "L = 28 r_p")
 
 
+@pytest.mark.parametrize("value, words", [("-3", "must be >= 0, not -3"),
+                                          ("2.5", "not a whole number: '2.5'")])
+def test_reproduce_checkpoint_must_be_a_count(tmp_path, value, words):
+    refused(gc(["reproduce", "--size", "paper", "--checkpoint", value], tmp_path), words)
+    assert not any(tmp_path.iterdir())
+
+
+def test_reproduce_checkpoint_reaches_the_runner(tmp_path, monkeypatch):
+    """--checkpoint K is the runner's restart-point interval (the engine's plan carries it to
+    every run); without it, none."""
+    from granular_charged.cli import build_parser, options as cli_options
+    from granular_charged.run import lammps_build
+    monkeypatch.setattr(lammps_build.LammpsBuild, "find", classmethod(lambda cls, d: None))
+    for argv, k in ((["reproduce", "--size", "paper", "--checkpoint", "200"], 200),
+                    (["reproduce", "--size", "paper"], 0)):
+        a = build_parser().parse_args(argv)
+        assert cli_options.runner(a).checkpoint == k
+
+
 @pytest.mark.parametrize("cmd", ["run", "sweep", "demo", "reproduce", "conventions"])
 def test_var_unknown_to_the_deck_is_an_error(tmp_path, cmd):
     # before: a misspelled --var L_RP 10 was ignored by the deck but named the folder

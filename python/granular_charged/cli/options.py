@@ -30,6 +30,17 @@ def count(text: str) -> int:
     return v
 
 
+def count_or_zero(text: str) -> int:
+    """argparse type: a whole number >= 0 (0: none; particles between restart points)."""
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if v < 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0, not {v}")
+    return v
+
+
 def common() -> argparse.ArgumentParser:
     """Options every subcommand takes (before or after its name)."""
     p = argparse.ArgumentParser(add_help=False)

@@ -33,6 +33,10 @@ def register(subparsers):
                         "to Ad = 20) with the deck's default protocols (many CPU hours)")
     p.add_argument("--quick", action="store_const", const="quick", dest="size",
                    help="the same as --size quick")
+    p.add_argument("--checkpoint", type=options.count_or_zero, default=0, metavar="K",
+                   help="plane-rain runs (the charged ones) leave a restart point every K "
+                        "particles; a study interrupted mid-run goes on from each run's last "
+                        "one when started again (0: none; an interrupted run starts over)")
     p.set_defaults(handler=run)
 
 
