@@ -8,6 +8,7 @@
 ------------------------------------------------------------------------- */
 
 #include "fix_sleep_gran.h"
+#include "sleep_bed_reach.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -505,7 +506,9 @@ int FixSleepGran::column_of(const double *x, int nbx, int nby) const
 }
 
 /* ----------------------------------------------------------------------
-   highest top (z + radius) of the bed per column of x, y
+   highest top (z + radius) of the bed per column of x, y: the bed's atoms up to the first gap
+   of more than two empty particle layers (sleep_bed_reach.h: a cluster hovering above the bed
+   is not its top)
 ------------------------------------------------------------------------- */
 
 void FixSleepGran::surface_heights(std::vector<double> &top, int &nbx, int &nby) const
@@ -518,20 +521,44 @@ void FixSleepGran::surface_heights(std::vector<double> &top, int &nbx, int &nby)
   const double side = rmax_all > 0.0 ? 2.0 * rmax_all : depth;
   nbx = MAX(1, static_cast<int>(domain->xprd / side));
   nby = MAX(1, static_cast<int>(domain->yprd / side));
-  std::vector<double> mine(static_cast<size_t>(nbx) * nby, -1.0e300);
-  top.assign(mine.size(), -1.0e300);
+  const size_t ncol = static_cast<size_t>(nbx) * nby;
+  top.assign(ncol, -1.0e300);
+
+  // the bed: sleepers and the atoms in contact slower than 10 x speed (not those falling
+  // onto it, nor slow ones hovering alone above a charged bed)
   double **x = atom->x, **v = atom->v;
   const double vbed2 = 100.0 * speed_sleep * speed_sleep;
+  auto in_bed = [&](int i) {
+    return asleep[i] != 0.0 ||
+        (ncontact[i] != 0.0 && v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2] < vbed2);
+  };
+  double span[2] = {-1.0e300, -1.0e300}, span_all[2];    // -lowest, highest z of the bed
+  for (int i = 0; i < atom->nlocal; i++)
+    if (in_bed(i)) {
+      span[0] = MAX(span[0], -x[i][2]);
+      span[1] = MAX(span[1], x[i][2]);
+    }
+  MPI_Allreduce(span, span_all, 2, MPI_DOUBLE, MPI_MAX, world);
+  if (span_all[1] < -1.0e299) return;    // no bed yet
+  const double zlo = -span_all[0];
+  const int nbz = static_cast<int>((span_all[1] - zlo) / side) + 1;
+  auto layer_of = [&](double z) { return MIN(MAX(static_cast<int>((z - zlo) / side), 0), nbz - 1); };
+
+  std::vector<unsigned char> mine(ncol * nbz, 0), occupied(ncol * nbz, 0);
+  for (int i = 0; i < atom->nlocal; i++)
+    if (in_bed(i)) mine[column_of(x[i], nbx, nby) * static_cast<size_t>(nbz) + layer_of(x[i][2])] = 1;
+  MPI_Allreduce(mine.data(), occupied.data(), static_cast<int>(mine.size()), MPI_UNSIGNED_CHAR,
+                MPI_MAX, world);
+  const std::vector<int> reach = GranularCharged::bed_reach(
+      occupied, nbx, nby, nbz, domain->xperiodic != 0, domain->yperiodic != 0, 2);
+
+  std::vector<double> mytop(ncol, -1.0e300);
   for (int i = 0; i < atom->nlocal; i++) {
-    // the bed: sleepers and the atoms in contact slower than 10 x speed (not those falling
-    // onto it, nor slow ones hovering above a charged bed)
-    if (asleep[i] == 0.0 &&
-        (ncontact[i] == 0.0 || v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2] >= vbed2))
-      continue;
-    double &t = mine[column_of(x[i], nbx, nby)];
-    t = MAX(t, x[i][2] + atom->radius[i]);
+    if (!in_bed(i)) continue;
+    const int c = column_of(x[i], nbx, nby);
+    if (layer_of(x[i][2]) < reach[c]) mytop[c] = MAX(mytop[c], x[i][2] + atom->radius[i]);
   }
-  MPI_Allreduce(mine.data(), top.data(), (int) mine.size(), MPI_DOUBLE, MPI_MAX, world);
+  MPI_Allreduce(mytop.data(), top.data(), static_cast<int>(ncol), MPI_DOUBLE, MPI_MAX, world);
 }
 
 /* ----------------------------------------------------------------------

@@ -34,6 +34,7 @@
 #include "exceptions.h"
 #include "force.h"
 #include "pair_granular_opt.h"
+#include "sleep_bed_reach.h"
 
 #include "gtest/gtest.h"
 #include "library.h"
@@ -398,6 +399,77 @@ TEST(FixSleepGran, CoulombSleepersRefusedCombinations)
   EXPECT_EQ(err("fix coul all coul/fmm farfield average sleepers full"), "no error");
   expect_match(err("fix coul all coul/fmm", "fix_modify coul virial yes"), "virial with the static sleepers");
   expect_match(err("fix coul all coul/fmm sleepers maybe"), "sleepers must be static or full, got maybe");
+}
+
+// a 3 x 3 x 6 lattice stack at rest on the floor (54 spheres, every one touching its lattice
+// neighbours; top of the bed 10.975e-6 m) and, with hovering, two touching spheres at rest at
+// z = 29.9e-6 m, far above it: a cluster that met in flight over a charged bed
+std::vector<std::string> stack(bool hovering)
+{
+  std::vector<std::string> c = {
+      "units si", "atom_style sphere", "atom_modify map array", "boundary p p f", "newton off",
+      "comm_modify vel yes", "lattice sc 1.995e-6", "region box block 0 3 0 3 -1 20",
+      "create_box 1 box", "region cells block 0 3 0 2 0 5", "create_atoms 1 region cells"};
+  if (hovering)
+    c.insert(c.end(), {"create_atoms 1 single 0.5 0.5 15", "create_atoms 1 single 1.5 0.5 15"});
+  c.insert(c.end(),
+           {"set group all diameter 2.0e-6", "set group all density 2500",
+            "pair_style granular/opt", std::string("pair_coeff * * ") + MODEL,
+            std::string("fix floor all wall/gran granular ") + MODEL + " zplane -0.999e-6 NULL",
+            "neighbor 2e-7 bin", "neigh_modify every 1 delay 0 check yes",
+            "fix integrate all nve/sphere", "timestep 5e-9", "thermo 0",
+            // the depth rule alone: 6e-6 m below the top, the three lowest layers (z <= 3.99e-6)
+            "fix sleep all sleep/gran speed 1e-2 force 1e-9 wake 1e-7 time none depth 6e-6 every 1",
+            "variable zsleep atom z*f_sleep", "compute zs all reduce max v_zsleep",
+            "thermo_style custom step f_sleep[2] c_zs"});
+  return c;
+}
+
+TEST(FixSleepGran, DepthRuleSleepsWhatLiesDeepBelowTheTop)
+{
+  Lmp l;
+  l.cmds(stack(false));
+  l.cmd("run 1");
+  EXPECT_EQ(l.var("f_sleep[2]"), 27.0) << "the three lowest layers of nine spheres";
+  EXPECT_DOUBLE_EQ(l.var("c_zs"), 2 * 1.995e-6) << "the highest sleeper is in the third layer";
+}
+
+// the cluster is in contact and slow, as the bed's top atoms are; taken for the top of its
+// columns it would put those columns' six layers to sleep (45 sleepers instead of 27)
+TEST(FixSleepGran, DepthRuleIgnoresAClusterHoveringAboveTheBed)
+{
+  Lmp l;
+  l.cmds(stack(true));
+  l.cmd("run 1");
+  EXPECT_EQ(l.var("f_sleep[2]"), 27.0) << "the same sleepers as without the cluster";
+  EXPECT_DOUBLE_EQ(l.var("c_zs"), 2 * 1.995e-6);
+}
+
+// the bed's reach in a column, without LAMMPS: layers up to the first run of more than
+// max_gap empty ones, occupancy over the column and its eight neighbours
+TEST(SleepBedReach, EndsAtAGapAndBridgesPores)
+{
+  const int nbx = 4, nby = 4, nbz = 12;
+  std::vector<unsigned char> occ(nbx * nby * nbz, 0);
+  auto set = [&](int bx, int by, int bz) { occ[(by * nbx + bx) * nbz + bz] = 1; };
+  for (int bz = 0; bz < 4; ++bz) set(1, 1, bz);    // a bed four layers tall in column (1, 1)
+  set(1, 1, 9);                                    // a cluster five empty layers above it
+  auto reach = GranularCharged::bed_reach(occ, nbx, nby, nbz, true, true, 2);
+  EXPECT_EQ(reach[1 * nbx + 1], 4) << "the cluster is not the bed";
+  EXPECT_EQ(reach[1 * nbx + 2], 4) << "a neighbour column shares the bed's reach";
+  EXPECT_EQ(reach[3 * nbx + 3], 0) << "a column far from every occupied one has no bed";
+  // the column filled in layers 6 and 7: its pores of two layers (4, 5) and one (8) are bridged
+  set(1, 1, 6);
+  set(1, 1, 7);
+  reach = GranularCharged::bed_reach(occ, nbx, nby, nbz, true, true, 2);
+  EXPECT_EQ(reach[1 * nbx + 1], 10) << "one bed up to the cluster";
+  occ.assign(occ.size(), 0);
+  for (int bz = 2; bz < 5; ++bz) set(3, 0, bz);    // starts above the grid's first layer
+  reach = GranularCharged::bed_reach(occ, nbx, nby, nbz, true, true, 2);
+  EXPECT_EQ(reach[0 * nbx + 0], 5) << "periodic in x: column 0 neighbours column 3";
+  reach = GranularCharged::bed_reach(occ, nbx, nby, nbz, false, true, 2);
+  EXPECT_EQ(reach[0 * nbx + 0], 0) << "not periodic: no neighbour across the box";
+  EXPECT_EQ(reach[0 * nbx + 3], 5);
 }
 
 TEST(FixSleepGran, BadInput)
