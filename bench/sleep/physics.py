@@ -5,8 +5,9 @@ of its standard error. Measures: phi and <Z> of the analysis slab (result.json),
 Z = 1-2 and 4-6, g(r) of the slab averaged over [1.95, 2.05] r_p... at r = 2 r_p (contact
 peak) and at 2 sqrt(3) r_p, the normal-force pdf (mean and standard deviation of F_n / F_C
 over the contacts with a force) and the CPU seconds. With --slabs: phi, <Z> and f(Z) of the
-middle and the top third of the analysis slab apart (a tall bed's sleepers lie in its middle,
-its last arrivals in its top), from the final dump with the definitions of the deck's computes.
+bottom, middle and top thirds of the analysis slab apart (a tall bed's sleepers lie in its bottom
+and middle, its last arrivals in its top), from the final dump with the definitions of the deck's
+computes.
 
     bench/sleep/physics.py [--slabs] REF_FOLDER VARIANT_FOLDER [...]    (folders of `granular-charged run --out`)
 """
@@ -22,11 +23,11 @@ from granular_charged.analysis import packing  # noqa: E402
 from granular_charged.params import jkr_scales, pair_modulus  # noqa: E402
 
 
-SLABS = {"mid": (1.0 / 3.0, 2.0 / 3.0), "top": (2.0 / 3.0, 1.0)}
+SLABS = {"bot": (0.0, 1.0 / 3.0), "mid": (1.0 / 3.0, 2.0 / 3.0), "top": (2.0 / 3.0, 1.0)}
 
 
 def slab_measures(snap, zlo: float, zhi: float) -> dict:
-    """phi, <Z>, f(Z = 1-2) and f(Z = 4-6) of the middle and top thirds of [zlo, zhi]."""
+    """phi, <Z>, f(Z = 1-2) and f(Z = 4-6) of the three thirds of [zlo, zhi]."""
     out = {}
     for name, (a, b) in SLABS.items():
         lo, hi = zlo + a * (zhi - zlo), zlo + b * (zhi - zlo)
