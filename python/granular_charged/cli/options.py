@@ -19,26 +19,24 @@ class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescript
     """Every option's default in --help; descriptions as written (their own line breaks)."""
 
 
-def count(text: str) -> int:
-    """argparse type: a whole number >= 1 (particles, ranks, jobs)."""
+def _whole_at_least(text: str, least: int) -> int:
     try:
         v = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, not {v}")
+    if v < least:
+        raise argparse.ArgumentTypeError(f"must be >= {least}, not {v}")
     return v
+
+
+def count(text: str) -> int:
+    """argparse type: a whole number >= 1 (particles, ranks, jobs)."""
+    return _whole_at_least(text, 1)
 
 
 def count_or_zero(text: str) -> int:
     """argparse type: a whole number >= 0 (0: none; particles between restart points)."""
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
-    if v < 0:
-        raise argparse.ArgumentTypeError(f"must be >= 0, not {v}")
-    return v
+    return _whole_at_least(text, 0)
 
 
 def common() -> argparse.ArgumentParser:
