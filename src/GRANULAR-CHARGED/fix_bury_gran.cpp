@@ -205,11 +205,30 @@ void FixBuryGran::init()
   if (history && ihistory > ime)
     error->all(FLERR, "Fix {} must come after the pair style's fix {} (define the pair style first)",
                style, history->id);
+  // a buried atom stays where it is because nothing integrates it: LAMMPS clears forces only
+  // up to atom->nfirst, and fix sleep/gran holds only the atoms before it
+  for (auto *f : fixes)
+    if (f->time_integrate && f->igroup != active_group)
+      error->all(FLERR,
+                 "Fix {} active {}: fix {} ({}) integrates group {}; with buried atoms every "
+                 "integrator must have group {}",
+                 style, gname, f->id, f->style, group->names[f->igroup], gname);
   // atoms inserted in pre_exchange must be there when the rule is applied, before the exchange
   for (int i = ime + 1; i < (int) fixes.size(); i++)
     if (utils::strmatch(fixes[i]->style, "^deposit") || utils::strmatch(fixes[i]->style, "^pour"))
       error->all(FLERR, "Fix {} must be defined after fix {} ({}), which inserts atoms", style,
                  fixes[i]->id, fixes[i]->style);
+}
+
+/* ---------------------------------------------------------------------- */
+
+void *FixBuryGran::extract(const char *name, int &dim)
+{
+  if (strcmp(name, "sleep") == 0) {
+    dim = 0;
+    return id_sleep;
+  }
+  return nullptr;
 }
 
 /* ----------------------------------------------------------------------

@@ -41,6 +41,8 @@ class FixBuryGran : public Fix {
   void end_of_step() override;
   double compute_vector(int) override;
   double memory_usage() override;
+  // "sleep" (dim 0, char *): the ID of the fix sleep/gran whose sleepers this fix buries
+  void *extract(const char *, int &) override;
 
   void grow_arrays(int) override;
   void copy_arrays(int, int, int) override;

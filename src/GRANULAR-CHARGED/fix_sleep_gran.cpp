@@ -49,7 +49,7 @@ FixSleepGran::FixSleepGran(LAMMPS *lmp, int narg, char **arg) :
     pushed(nullptr), rest_steps(nullptr), push(nullptr), wake_mark(nullptr), ncontact(nullptr),
     comm_mode(COMM_FLAGS),
     set_generation(0), fallen_asleep_total(0), woken_total(0), pair_history(nullptr),
-    active_build(-1), active_generation(-1)
+    active_build(-1), active_generation(-1), buried_past_nfirst(false)
 {
   if (!(atom->radius_flag && atom->rmass_flag && atom->omega_flag && atom->torque_flag))
     error->all(FLERR, "Fix {} requires atom attributes radius, rmass, omega and torque (atom_style sphere)", style);
@@ -185,6 +185,15 @@ void FixSleepGran::init()
   if (update->whichflag == 2) error->all(FLERR, "Fix {} cannot be used with minimization", style);
   check_fix_order();
   active_build = active_generation = -1;    // the pair's list may be another one
+  // fix bury/gran keeps its group (that of atom_modify first) equal to the atoms that may move
+  // or be touched: its buried sleepers lie past atom->nfirst (LAMMPS orders them there at each
+  // build), out of the pair's list and of the ghosts, with zero velocity, force and spin
+  buried_past_nfirst = false;
+  for (auto *f : modify->get_fix_by_style("^bury/gran$")) {
+    int dim = -1;
+    const auto *sleep_id = static_cast<const char *>(f->extract("sleep", dim));
+    if (sleep_id && strcmp(sleep_id, id) == 0) buried_past_nfirst = true;
+  }
   rest_steps_needed = static_cast<int>(std::ceil(rest_time / update->dt - 1e-9));
 }
 
@@ -214,11 +223,7 @@ void FixSleepGran::check_fix_order()
 void FixSleepGran::setup_pre_force(int /*vflag*/)
 {
   exchange_flags();
-  const int nall = atom->nlocal + atom->nghost;
-  for (int i = 0; i < nall; i++) {
-    push[i][0] = push[i][1] = push[i][2] = 0.0;
-    ncontact[i] = 0.0;
-  }
+  clear_push_and_contacts();
 }
 
 /* ---------------------------------------------------------------------- */
@@ -235,11 +240,31 @@ void FixSleepGran::setup(int /*vflag*/)
 void FixSleepGran::pre_force(int /*vflag*/)
 {
   if (neighbor->ago == 0) exchange_flags();
-  const int nall = atom->nlocal + atom->nghost;
-  for (int i = 0; i < nall; i++) {
-    push[i][0] = push[i][1] = push[i][2] = 0.0;
-    ncontact[i] = 0.0;
-  }
+  clear_push_and_contacts();
+}
+
+/* ---------------------------------------------------------------------- */
+
+void FixSleepGran::clear_push_and_contacts()
+{
+  auto clear = [&](int from, int to) {
+    for (int i = from; i < to; i++) {
+      push[i][0] = push[i][1] = push[i][2] = 0.0;
+      ncontact[i] = 0.0;
+    }
+  };
+  clear(0, nvisited());
+  clear(atom->nlocal, atom->nlocal + atom->nghost);
+}
+
+/* ----------------------------------------------------------------------
+   the local atoms visited each step: all of them, or with a fix bury/gran of this fix those
+   before atom->nfirst (the others are buried sleepers: not listed, not ghosts, held at rest)
+------------------------------------------------------------------------- */
+
+int FixSleepGran::nvisited() const
+{
+  return buried_past_nfirst ? atom->nfirst : atom->nlocal;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -259,13 +284,12 @@ void FixSleepGran::post_force(int /*vflag*/)
     comm_mode = COMM_PUSH;
     comm->reverse_comm(this, 4);
   }
-  const int nlocal = atom->nlocal;
-
   wake_pushed();
 
   // rest time of the awake atoms of the group (those woken now start counting next step)
   int *mask = atom->mask;
-  for (int i = 0; i < nlocal; i++) {
+  const int nvisit = nvisited();
+  for (int i = 0; i < nvisit; i++) {
     if (asleep[i] != 0.0 || wake_mark[i] != 0.0) continue;
     if ((mask[i] & groupbit) && ncontact[i] > 0.0 && at_rest(i))
       rest_steps[i] += 1.0;
@@ -394,12 +418,14 @@ bool FixSleepGran::at_rest(int i) const
 
 void FixSleepGran::wake_pushed()
 {
-  const int nlocal = atom->nlocal;
+  const int nlocal = atom->nlocal, nvisit = nvisited();
   const int nall = nlocal + atom->nghost;
   const double fw2 = force_wake * force_wake;
   int woken = 0;
-  for (int i = 0; i < nall; i++) wake_mark[i] = pushed[i] = 0.0;    // also read by post_force()
-  for (int i = 0; i < nlocal; i++) {
+  // also read by post_force(); the buried atoms' are not read
+  for (int i = 0; i < nvisit; i++) wake_mark[i] = pushed[i] = 0.0;
+  for (int i = nlocal; i < nall; i++) wake_mark[i] = pushed[i] = 0.0;
+  for (int i = 0; i < nvisit; i++) {
     if (asleep[i] == 0.0) continue;
     const double *p = push[i];
     if (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] > fw2) {
@@ -420,7 +446,7 @@ void FixSleepGran::wake_pushed()
   comm->reverse_comm(this, 1);
 
   int nwoken = 0;
-  for (int i = 0; i < nlocal; i++) {
+  for (int i = 0; i < nvisit; i++) {
     if (wake_mark[i] == 0.0) continue;
     asleep[i] = 0.0;
     rest_steps[i] = 0.0;
@@ -569,7 +595,8 @@ void FixSleepGran::surface_heights(std::vector<double> &top, int &nbx, int &nby)
 void FixSleepGran::hold_sleepers(bool woken_too)
 {
   double **v = atom->v, **w = atom->omega, **f = atom->f, **t = atom->torque;
-  for (int i = 0; i < atom->nlocal; i++) {
+  const int nvisit = nvisited();
+  for (int i = 0; i < nvisit; i++) {
     if (asleep[i] == 0.0 && !(woken_too && wake_mark[i] != 0.0)) continue;
     v[i][0] = v[i][1] = v[i][2] = 0.0;
     w[i][0] = w[i][1] = w[i][2] = 0.0;

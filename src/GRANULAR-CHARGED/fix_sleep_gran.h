@@ -77,6 +77,8 @@ class FixSleepGran : public Fix {
   //   touches another can fall asleep
   // "pairs_awake" (dim 0, int): 1 with keyword pairs awake (the pair style leaves out the pairs
   //   of two sleepers, by the flags of "sleeping"), 0 with pairs all
+  // With a fix bury/gran of this fix, "push" and "contacts" hold no values for the local atoms
+  // past atom->nfirst (the buried sleepers, which this fix does not visit each step).
   void *extract(const char *, int &) override;
 
  private:
@@ -101,8 +103,13 @@ class FixSleepGran : public Fix {
   // the entries of the pair's list with an awake atom or neighbor (update_active_entries())
   std::vector<int> active_entries;
   bigint active_build, active_generation;    // the list build and sleeping set they are of
+  // a fix bury/gran of this fix keeps its buried sleepers past atom->nfirst (set in init())
+  bool buried_past_nfirst;
+
+  int nvisited() const;
 
   void exchange_flags();
+  void clear_push_and_contacts();
   void sum_contacts_and_push();
   void update_active_entries(const class NeighList *list);
   void mark_touching_sleepers();

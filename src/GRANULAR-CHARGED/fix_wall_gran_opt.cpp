@@ -176,7 +176,8 @@ void FixWallGranOpt::gather_contacts()
   double **x = atom->x;
   const double *radius = atom->radius;
   const int *mask = atom->mask;
-  const int nlocal = atom->nlocal;
+  // the group of atom_modify first: its atoms come first (as in LAMMPS's integrators)
+  const int nlocal = igroup == atom->firstgroup ? atom->nfirst : atom->nlocal;
   const int nhistory = size_history;
   const bool adhesive = coeffs.gamma != 0.0;
   contacts.clear();

@@ -86,13 +86,18 @@ std::vector<std::string> rain_deck(const std::string &grid, const std::string &n
                                 "region box block 0 8 0 8 -1 40", "create_box 1 box"};
   if (bury) d.insert(d.end(), ACTIVE.begin(), ACTIVE.end());
   const std::string g = bury ? "active" : "all";
+  // granular/opt: its floor wall/gran/opt on the group (looping over the first atoms only) and
+  // gravity on all, so that the buried atoms get forces that nothing clears and must not move
+  const bool opt = pair == "granular/opt";
+  const std::string floor = opt ? "fix floor " + g + " wall/gran/opt granular " : "fix floor all wall/gran granular ";
+  const std::string gravity = opt ? "all" : g;
   std::vector<std::string> rest = {
       "region cells block 0 8 0 8 0 5", "create_atoms 1 region cells", "group bed region cells",
       "set group all diameter 2.0e-6", "set group all density 2500", "pair_style " + pair,
       std::string("pair_coeff * * ") + MODEL,
-      std::string("fix floor all wall/gran granular ") + MODEL + " zplane -0.999e-6 NULL",
+      floor + MODEL + " zplane -0.999e-6 NULL",
       "neighbor 2e-7 bin", "neigh_modify every 1 delay 0 check yes",
-      "fix integrate " + g + " nve/sphere", "fix grav " + g + " gravity 9.81 vector 0 0 -1",
+      "fix integrate " + g + " nve/sphere", "fix grav " + gravity + " gravity 9.81 vector 0 0 -1",
       "timestep 5e-9", "thermo 0", "reset_timestep 999999",
       "fix sleep all sleep/gran speed 1e3 force 1.0 wake 1e-7 time 0 every 1000000"};
   d.insert(d.end(), rest.begin(), rest.end());
@@ -378,16 +383,17 @@ TEST(BuryGran, KeptHistoriesSurviveARestart)
 
 // a one-atom deck with the group commands `active` and the fixes `fixes`, then run 0
 std::vector<std::string> error_deck(const std::vector<std::string> &active,
-                                    const std::vector<std::string> &fixes)
+                                    const std::vector<std::string> &fixes,
+                                    const std::string &integrated = "active")
 {
   std::vector<std::string> d = {"units si", "atom_style sphere", "boundary p p f",
                                 "region box block 0 8e-6 0 8e-6 0 8e-6", "create_box 1 box",
                                 "comm_modify vel yes", "group active empty", "group other empty"};
   d.insert(d.end(), active.begin(), active.end());
-  for (const std::string c :
-       {"create_atoms 1 single 4e-6 4e-6 3e-6 units box", "set group all diameter 2.0e-6",
+  for (const std::string &c : std::vector<std::string>{
+           "create_atoms 1 single 4e-6 4e-6 3e-6 units box", "set group all diameter 2.0e-6",
         "set group all density 2500", "pair_style granular", "neighbor 2e-7 bin",
-        "fix integrate all nve/sphere", "timestep 5e-9"})
+        "fix integrate " + integrated + " nve/sphere", "timestep 5e-9"})
     d.push_back(c);
   d.push_back(std::string("pair_coeff * * ") + MODEL);
   d.insert(d.end(), fixes.begin(), fixes.end());
@@ -404,6 +410,11 @@ TEST(BuryGran, InputErrors)
   const std::string bury = "fix bury all bury/gran sleep sleep active active halo 6.5e-6";
   // the deck with all three commands and both fixes runs
   EXPECT_EQ(gctest::error_of(error_deck(all3, {sleep, bury})), "no error");
+  // buried atoms are held by not being integrated
+  for (const std::string g : {"all", "other"})
+    EXPECT_THAT(gctest::error_of(error_deck(all3, {sleep, bury}, g)),
+                HasSubstr("fix integrate (nve/sphere) integrates group " + g +
+                          "; with buried atoms every integrator must have group active"));
 
   EXPECT_THAT(gctest::error_of(error_deck(all3, {sleep, "fix bury all bury/gran sleep sleep active active halo 6e-6"})),
               HasSubstr("halo 6e-06 is below the neighbor cutoff"));
