@@ -9,6 +9,8 @@
 
 #include "fix_bury_gran.h"
 
+#include "bury_cells.h"
+
 #include "atom.h"
 #include "comm.h"
 #include "domain.h"
@@ -42,45 +44,6 @@ struct CommBorderGroup : public Comm {
   static int of(const Comm *c) { return c->*(&CommBorderGroup::bordergroup); }
 };
 
-// index of the column (n columns of width w from lo) holding coordinate c, periodic or clamped
-int column_index(double c, double lo, double w, int n, bool periodic)
-{
-  int b = static_cast<int>(std::floor((c - lo) / w));
-  if (periodic) {
-    b %= n;
-    if (b < 0) b += n;
-  } else {
-    b = std::min(std::max(b, 0), n - 1);
-  }
-  return b;
-}
-
-// each flag becomes 1 if any flag of the window [e - k, e + k] along one axis (0, 1, 2) of a
-// grid of n[0] x n[1] x n[2] flags (x fastest) is set (periodic: wrapped; else clamped), by
-// running counts: linear in the grid size whatever k
-void window_any(std::vector<unsigned char> &v, const int n[3], int axis, int k, bool periodic)
-{
-  const int len = n[axis];
-  const size_t stride = axis == 0 ? 1 : (axis == 1 ? n[0] : static_cast<size_t>(n[0]) * n[1]);
-  const int o1 = axis == 0 ? n[1] : n[0], o2 = axis == 2 ? n[1] : n[2];
-  const size_t s1 = axis == 0 ? n[0] : 1;
-  const size_t s2 = axis == 2 ? n[0] : static_cast<size_t>(n[0]) * n[1];
-  if (periodic) k = std::min(k, len);    // the whole ring
-  std::vector<int> count(len + 1);
-  for (int b = 0; b < o2; b++)
-    for (int a = 0; a < o1; a++) {
-      const size_t start = a * s1 + b * s2;
-      count[0] = 0;
-      for (int e = 0; e < len; e++) count[e + 1] = count[e] + (v[start + e * stride] ? 1 : 0);
-      auto sum = [&](int from, int to) {    // flags in [from, to], from <= to, within one period
-        if (!periodic) return count[std::min(to, len - 1) + 1] - count[std::max(from, 0)];
-        if (to - from + 1 >= len) return count[len];
-        const int f = ((from % len) + len) % len, t = ((to % len) + len) % len;
-        return f <= t ? count[t + 1] - count[f] : count[len] - count[f] + count[t + 1];
-      };
-      for (int e = 0; e < len; e++) v[start + e * stride] = sum(e - k, e + k) > 0 ? 1 : 0;
-    }
-}
 }    // namespace
 
 /* ---------------------------------------------------------------------- */
@@ -310,48 +273,75 @@ void FixBuryGran::end_of_step()
 
 bool FixBuryGran::apply_rule()
 {
+  using GranularCharged::column_index;
   const int nlocal = atom->nlocal;
   double **x = atom->x;
   int *mask = atom->mask;
   int dim = 0;
   const double *asleep = static_cast<double *>(sleep_fix->extract("sleeping", dim));
+  auto is_sleeper = [&](int i) { return (mask[i] & groupbit) && asleep[i] != 0.0; };
 
-  double rmax = 0.0, rmax_all = 0.0;
-  for (int i = 0; i < nlocal; i++) rmax = MAX(rmax, atom->radius[i]);
-  MPI_Allreduce(&rmax, &rmax_all, 1, MPI_DOUBLE, MPI_MAX, world);
+  // the largest radius, and the lowest and highest sleeper of the fix group, over all ranks
+  double mine_max[3] = {0.0, -INFINITY, -INFINITY}, all_max[3];    // rmax, -zlo, zhi
+  for (int i = 0; i < nlocal; i++) {
+    mine_max[0] = MAX(mine_max[0], atom->radius[i]);
+    if (!is_sleeper(i)) continue;
+    mine_max[1] = MAX(mine_max[1], -x[i][2]);
+    mine_max[2] = MAX(mine_max[2], x[i][2]);
+  }
+  MPI_Allreduce(mine_max, all_max, 3, MPI_DOUBLE, MPI_MAX, world);
+  const double rmax_all = all_max[0];
+  const bool any_sleeper = all_max[2] > -INFINITY;
+
   // cells one largest diameter wide in x and y (the columns of fix sleep/gran's depth rule),
   // cut into slabs of a quarter of that in z: the rule keeps sleepers up to the cells' sizes
   // beyond halo, less in z, where the bed is deep
   const double side = rmax_all > 0.0 ? 2.0 * rmax_all : halo;
   const double *prd = domain->prd, *lo = domain->boxlo;
   const int periodic[3] = {domain->xperiodic, domain->yperiodic, domain->zperiodic};
-  int n[3];
+  int n[3], k[3];
   double w[3];
   for (int d = 0; d < 3; d++) {
     n[d] = MAX(1, static_cast<int>(prd[d] / (d == 2 ? 0.25 * side : side)));
     w[d] = prd[d] / n[d];
+    k[d] = MAX(1, static_cast<int>(std::ceil(halo / w[d])));
   }
-  auto cell_of = [&](const double *xi) {
-    size_t c = 0;
-    for (int d = 2; d >= 0; d--) c = c * n[d] + column_index(xi[d], lo[d], w[d], n[d], periodic[d]);
-    return c;
+  // only the slabs within k[2] of a sleeper's slab decide anything (non-periodic z): an awake
+  // atom farther in z is farther than the window from every sleeper; the grid is cut to them
+  int z0 = 0, nz = n[2];
+  if (any_sleeper && !periodic[2]) {
+    z0 = MAX(0, column_index(-all_max[1], lo[2], w[2], n[2], false) - k[2]);
+    nz = MIN(n[2] - 1, column_index(all_max[2], lo[2], w[2], n[2], false) + k[2]) - z0 + 1;
+  }
+  const int grid[3] = {n[0], n[1], nz};
+  // the cell of x, or -1 for a slab outside the grid
+  auto cell_of = [&](const double *xi) -> long {
+    const int cz = column_index(xi[2], lo[2], w[2], n[2], periodic[2]) - z0;
+    if (cz < 0 || cz >= nz) return -1;
+    const int cy = column_index(xi[1], lo[1], w[1], n[1], periodic[1]);
+    const int cx = column_index(xi[0], lo[0], w[0], n[0], periodic[0]);
+    return (static_cast<long>(cz) * n[1] + cy) * n[0] + cx;
   };
 
-  // the cells holding an awake atom, over all ranks
-  std::vector<unsigned char> mine(static_cast<size_t>(n[0]) * n[1] * n[2], 0), near(mine.size(), 0);
-  for (int i = 0; i < nlocal; i++)
-    if (asleep[i] == 0.0) mine[cell_of(x[i])] = 1;
-  MPI_Allreduce(mine.data(), near.data(), (int) mine.size(), MPI_UNSIGNED_CHAR, MPI_MAX, world);
-
-  // the cells within halo of such a cell in x, y and z (at least the 26 neighbours): a sleeper
-  // within halo of an awake atom, in each coordinate, is in one of them
-  for (int d = 0; d < 3; d++)
-    window_any(near, n, d, MAX(1, static_cast<int>(std::ceil(halo / w[d]))), periodic[d]);
+  // the cells holding an awake atom, over all ranks, widened by halo in x, y and z (at least
+  // the 26 neighbours): a sleeper within halo of an awake atom, in each coordinate, is in one
+  // of them. Without sleepers nothing is buried and no grid is needed.
+  std::vector<unsigned char> near;
+  if (any_sleeper) {
+    std::vector<unsigned char> mine(static_cast<size_t>(n[0]) * n[1] * nz, 0);
+    near.assign(mine.size(), 0);
+    for (int i = 0; i < nlocal; i++) {
+      if (asleep[i] != 0.0) continue;
+      const long c = cell_of(x[i]);
+      if (c >= 0) mine[c] = 1;
+    }
+    MPI_Allreduce(mine.data(), near.data(), (int) mine.size(), MPI_UNSIGNED_CHAR, MPI_MAX, world);
+    for (int d = 0; d < 3; d++) GranularCharged::window_any(near, grid, d, k[d], periodic[d]);
+  }
 
   bigint counts[3] = {0, 0, 0}, all[3] = {0, 0, 0};    // changed, active, buried
   for (int i = 0; i < nlocal; i++) {
-    const bool keep =
-        !(mask[i] & groupbit) || asleep[i] == 0.0 || near[cell_of(x[i])] != 0;
+    const bool keep = !is_sleeper(i) || near[cell_of(x[i])] != 0;
     const bool in = mask[i] & active_bit;
     if (keep != in) {
       counts[0]++;

@@ -286,9 +286,10 @@ void FixSleepGran::post_force(int /*vflag*/)
   }
   wake_pushed();
 
-  // rest time of the awake atoms of the group (those woken now start counting next step)
+  // rest time of the awake atoms of the group (those woken now start counting next step);
+  // with time none nothing reads it
   int *mask = atom->mask;
-  const int nvisit = nvisited();
+  const int nvisit = rest_rule ? nvisited() : 0;
   for (int i = 0; i < nvisit; i++) {
     if (asleep[i] != 0.0 || wake_mark[i] != 0.0) continue;
     if ((mask[i] & groupbit) && ncontact[i] > 0.0 && at_rest(i))

@@ -38,6 +38,8 @@
    back from the restart file). */
 #include "gc_testing.h"
 
+#include "bury_cells.h"
+
 #include "atom.h"
 #include "fix.h"
 #include "fix_neigh_history.h"
@@ -56,6 +58,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -444,4 +447,54 @@ TEST(BuryGran, InputErrors)
                                                  "region top block EDGE EDGE EDGE EDGE 6e-6 8e-6 units box",
                                                  "fix drop all deposit 1 1 100 12345 region top"})),
               HasSubstr("must be defined after fix drop (deposit)"));
+}
+
+// the cell window against its definition, on random grids: every axis periodic or clamped,
+// windows from 0 cells to wider than the ring, sparse and dense flags
+TEST(BuryCells, WindowAnyAsItsDefinition)
+{
+  std::mt19937 rng(20261207);
+  for (int trial = 0; trial < 400; trial++) {
+    const int n[3] = {1 + (int) (rng() % 9), 1 + (int) (rng() % 9), 1 + (int) (rng() % 13)};
+    const int axis = (int) (rng() % 3), k = (int) (rng() % 12);
+    const bool periodic = rng() % 2;
+    const double density = (rng() % 4) * 0.1;
+    std::vector<unsigned char> v(static_cast<size_t>(n[0]) * n[1] * n[2]);
+    std::bernoulli_distribution flag(density);
+    for (auto &f : v) f = flag(rng) ? 1 : 0;
+    auto at = [&](const std::vector<unsigned char> &g, int c[3]) {
+      return g[(static_cast<size_t>(c[2]) * n[1] + c[1]) * n[0] + c[0]];
+    };
+    std::vector<unsigned char> expected(v.size());
+    for (int z = 0; z < n[2]; z++)
+      for (int y = 0; y < n[1]; y++)
+        for (int x = 0; x < n[0]; x++) {
+          int c[3] = {x, y, z};
+          const int e = c[axis];
+          bool any = false;
+          for (int o = e - k; o <= e + k && !any; o++) {
+            int m = o;
+            if (periodic) m = ((o % n[axis]) + n[axis]) % n[axis];
+            else if (o < 0 || o >= n[axis]) continue;
+            int d[3] = {x, y, z};
+            d[axis] = m;
+            any = at(v, d) != 0;
+          }
+          expected[(static_cast<size_t>(z) * n[1] + y) * n[0] + x] = any ? 1 : 0;
+        }
+    GranularCharged::window_any(v, n, axis, k, periodic);
+    ASSERT_EQ(v, expected) << "grid " << n[0] << "x" << n[1] << "x" << n[2] << ", axis " << axis
+                           << ", k " << k << (periodic ? ", periodic" : ", clamped");
+  }
+}
+
+TEST(BuryCells, ColumnIndexWrapsOrClamps)
+{
+  using GranularCharged::column_index;
+  EXPECT_EQ(column_index(0.5, 0.0, 1.0, 4, true), 0);
+  EXPECT_EQ(column_index(-0.5, 0.0, 1.0, 4, true), 3);
+  EXPECT_EQ(column_index(4.5, 0.0, 1.0, 4, true), 0);
+  EXPECT_EQ(column_index(-0.5, 0.0, 1.0, 4, false), 0);
+  EXPECT_EQ(column_index(9.0, 0.0, 1.0, 4, false), 3);
+  EXPECT_EQ(column_index(2.5, 1.0, 0.5, 8, false), 3);
 }
