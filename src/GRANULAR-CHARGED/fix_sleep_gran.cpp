@@ -334,19 +334,26 @@ void FixSleepGran::sum_contacts_and_push()
   const int size_history = pair_history ? pair_history->get_dnum() : 0;
   kept_history.resize(size_history);
   update_active_entries(list);
-  for (const int ii : active_entries) {
+  // the contact counts are read on commit steps only (and each step by the rest rule); on the
+  // other steps only the pushes are summed, over the entries of awake-sleeper pairs
+  const bool count = rest_rule || update->ntimestep % every == 0;
+  for (const int ii : count ? active_entries : interface_entries) {
     const int i = list->ilist[ii];
     const int *jlist = list->firstneigh[i];
     const int *touch = pair_history ? pair_history->firstflag[i] : nullptr;
     for (int jj = 0; jj < list->numneigh[i]; jj++) {
       const double factor_lj = special_lj[(jlist[jj] >> SBBITS) & 3];
       const int j = jlist[jj] & NEIGHMASK;
+      const bool pushes = (asleep[i] != 0.0) != (asleep[j] != 0.0);    // one asleep, one awake
       if (factor_lj == 0.0 || (asleep[i] != 0.0 && asleep[j] != 0.0)) continue;
+      if (!count && !pushes) continue;
       if (!touching(i, j, jj, touch)) continue;
       const bool j_here = newton_pair || j < nlocal;
-      ncontact[i] += 1.0;
-      if (j_here) ncontact[j] += 1.0;
-      if (asleep[i] == 0.0 && asleep[j] == 0.0) continue;
+      if (count) {
+        ncontact[i] += 1.0;
+        if (j_here) ncontact[j] += 1.0;
+      }
+      if (!pushes) continue;
       double dx[3] = {x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]};
       const double rsq = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
       double fpair = 0.0;
@@ -366,8 +373,9 @@ void FixSleepGran::sum_contacts_and_push()
 
 /* ----------------------------------------------------------------------
    the entries of the pair's list that hold a pair with an awake atom (an awake atom, or a
-   sleeper with an awake neighbor), rebuilt after each neighbor list build and each change of
-   the sleeping set
+   sleeper with an awake neighbor), and those that hold an awake-sleeper pair (the bed's
+   surface, where pushes are summed), rebuilt after each neighbor list build and each change
+   of the sleeping set
 ------------------------------------------------------------------------- */
 
 void FixSleepGran::update_active_entries(const NeighList *list)
@@ -376,12 +384,18 @@ void FixSleepGran::update_active_entries(const NeighList *list)
   active_build = neighbor->lastcall;
   active_generation = set_generation;
   active_entries.clear();
+  interface_entries.clear();
   for (int ii = 0; ii < list->inum; ii++) {
     const int i = list->ilist[ii];
-    bool keep = asleep[i] == 0.0;
+    const bool i_awake = asleep[i] == 0.0;
+    bool awake_j = false, asleep_j = false;
     const int *jlist = list->firstneigh[i];
-    for (int jj = 0; !keep && jj < list->numneigh[i]; jj++) keep = asleep[jlist[jj] & NEIGHMASK] == 0.0;
-    if (keep) active_entries.push_back(ii);
+    for (int jj = 0; jj < list->numneigh[i] && !(awake_j && asleep_j); jj++) {
+      if (asleep[jlist[jj] & NEIGHMASK] == 0.0) awake_j = true;
+      else asleep_j = true;
+    }
+    if (i_awake || awake_j) active_entries.push_back(ii);
+    if (i_awake ? asleep_j : awake_j) interface_entries.push_back(ii);
   }
 }
 

@@ -73,8 +73,8 @@ class FixSleepGran : public Fix {
   // "push" (dim 2): per atom (local and ghost), the contact force on a sleeper from its awake
   //   partners (zeroed in pre_force, summed in post_force)
   // "contacts" (dim 1): per atom (local and ghost), contacts computed this step (zeroed in
-  //   pre_force, counted in post_force; pairs of two sleepers not counted); only an atom that
-  //   touches another can fall asleep
+  //   pre_force, counted in post_force; pairs of two sleepers not counted) on commit steps, and
+  //   on every step with a rest time (else 0); only an atom that touches another can fall asleep
   // "pairs_awake" (dim 0, int): 1 with keyword pairs awake (the pair style leaves out the pairs
   //   of two sleepers, by the flags of "sleeping"), 0 with pairs all
   // With a fix bury/gran of this fix, "push" and "contacts" hold no values for the local atoms
@@ -100,8 +100,9 @@ class FixSleepGran : public Fix {
   bigint fallen_asleep_total, woken_total;
   class FixNeighHistory *pair_history;    // the pair style's contact flags (null: none)
   std::vector<double> kept_history;       // one contact's history, kept across single()
-  // the entries of the pair's list with an awake atom or neighbor (update_active_entries())
-  std::vector<int> active_entries;
+  // the entries of the pair's list with an awake atom or neighbor, and those of them with an
+  // awake atom and a sleeping neighbor or the reverse (update_active_entries())
+  std::vector<int> active_entries, interface_entries;
   bigint active_build, active_generation;    // the list build and sleeping set they are of
   // a fix bury/gran of this fix keeps its buried sleepers past atom->nfirst (set in init())
   bool buried_past_nfirst;

@@ -16,6 +16,12 @@
    - ChainAcrossRanks (1, 2, 3 ranks): four touching sleepers in a row across a sub-domain face;
      a sphere hits the second. On the step of the impact the second (pushed) and its two
      neighbours wake, the fourth (touching only sleepers, not pushed) stays asleep.
+   - SurfacePushesAsFromTheWholeList (1, 2 ranks): with a rest time the fix counts contacts on
+     every step, over every list entry with an awake atom; without one (time none) it counts
+     them on commit steps only and sums the pushes over the entries of awake-sleeper pairs.
+     The same bed put to sleep by either rule is rained on: on every step each sleeper's push
+     is the same bit for bit, the same sleepers wake and every atom ends where it ends with the
+     other rule.
    - CountsRightAfterReadRestart: f_sleep and f_sleep[2] read after read_restart, before any
      run, give the awake and sleeping atoms of the restart (27 asleep, 5 awake).
 
@@ -61,7 +67,9 @@ constexpr int NSTEPS = 3000;    // the rain lands within ~2500 steps
 // the bed falls asleep on the commit step 1000000 (every 1000000: no other commit follows,
 // so a woken sleeper stays awake and the woken set is the sleepers awake at the end), then 80
 // spheres rain on it from 3-14 um above at 1 m/s with a little thermal spread
-std::vector<std::string> rain_deck(const std::string &grid, const std::string &newton)
+// rule: the fix's falling-asleep rule (both put every bed atom to sleep on the commit step)
+std::vector<std::string> rain_deck(const std::string &grid, const std::string &newton,
+                                   const std::string &rule = "time 0")
 {
   return {"units si", "atom_style sphere", "atom_modify map array", "boundary p p f",
           "newton " + newton, "comm_modify vel yes", "processors " + grid,
@@ -77,8 +85,8 @@ std::vector<std::string> rain_deck(const std::string &grid, const std::string &n
           "neighbor 2e-7 bin", "neigh_modify every 1 delay 0 check yes",
           "fix integrate all nve/sphere", "fix grav all gravity 9.81 vector 0 0 -1",
           "timestep 5e-9", "thermo 0", "reset_timestep 999999",
-          fmt::format("fix sleep all sleep/gran speed 1e3 force 1.0 wake {} time 0 every 1000000",
-                      WAKE),
+          fmt::format("fix sleep all sleep/gran speed 1e3 force 1.0 wake {} {} every 1000000",
+                      WAKE, rule),
           "run 1",
           "region above block EDGE EDGE EDGE EDGE 9.0e-6 20e-6 units box",
           "create_atoms 1 random 80 4711 above overlap 2.2e-6 maxtry 1000 units box",
@@ -179,6 +187,45 @@ TEST(SleepWake, TheDocumentedRuleStepByStep)
   EXPECT_GT(pushed_total, 3) << "the rain pushes sleepers";
   EXPECT_GT(touching_total, 3) << "and wakes their neighbours";
   EXPECT_LT(woken_total, NBED / 4) << "no cascade: the threshold is above the static forces";
+}
+
+TEST(SleepWake, SurfacePushesAsFromTheWholeList)
+{
+  const std::string grid = nprocs() == 2 ? "2 1 1" : "1 1 1";
+  if (nprocs() > 2) GTEST_SKIP() << "1 and 2 ranks";
+  Lmp every_step, surface;
+  every_step.cmds(rain_deck(grid, "off", "time 0"));
+  surface.cmds(rain_deck(grid, "off", "time none depth 1e-30"));
+  ASSERT_EQ(every_step.var("f_sleep[2]"), NBED) << "the rest rule puts the whole bed to sleep";
+  ASSERT_EQ(surface.var("f_sleep[2]"), NBED) << "the depth rule puts the whole bed to sleep";
+  // the push on every sleeper, step by step: the same sums in the same order
+  auto push_of = [](Lmp &l) {
+    int dim = 0;
+    auto *fix = l.lmp->modify->get_fix_by_id("sleep");
+    double **push = static_cast<double **>(fix->extract("push", dim));
+    std::vector<double> p;
+    for (int i = 0; i < l.lmp->atom->nlocal; i++) p.insert(p.end(), push[i], push[i] + 3);
+    return p;
+  };
+  int differ = 0, pushed = 0;
+  for (int step = 1; step <= NSTEPS; step++) {
+    const std::string run = step == 1 ? "run 1" : "run 1 pre no post no";
+    every_step.cmd(run);
+    surface.cmd(run);
+    const auto pe = push_of(every_step), ps = push_of(surface);
+    if (pe != ps) differ++;
+    for (double v : pe) pushed += v != 0.0;
+  }
+  int differ_all = 0, pushed_all = 0;
+  MPI_Allreduce(&differ, &differ_all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Allreduce(&pushed, &pushed_all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_GT(pushed_all, 1000) << "the rain pushes sleepers";
+  EXPECT_EQ(differ_all, 0) << "steps on which a rank's pushes differ";
+  const auto woken = awake_cells(every_step);
+  EXPECT_GT(woken.size(), 10u) << "the rain wakes sleepers";
+  EXPECT_EQ(awake_cells(surface), woken);
+  EXPECT_EQ(gctest::gather(surface, "x", 3), gctest::gather(every_step, "x", 3))
+      << "positions as with the contacts counted on every step";
 }
 
 TEST(SleepWake, SameSleepersWakeOnEveryGrid)
