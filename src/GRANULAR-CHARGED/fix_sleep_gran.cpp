@@ -9,6 +9,7 @@
 
 #include "fix_sleep_gran.h"
 #include "sleep_bed_reach.h"
+#include "wall_gran_touch.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -173,6 +174,15 @@ void FixSleepGran::init()
   if (histories.size() > 1)
     error->all(FLERR, "Fix {} needs a single granular pair style with one contact history", style);
   pair_history = histories.empty() ? nullptr : dynamic_cast<FixNeighHistory *>(histories.front());
+  // an atom resting on a granular wall touches something: its wall contacts count with its pair
+  // contacts (a wall whose model does not flag its contacts is left out, see the doc)
+  walls.clear();
+  for (auto *f : modify->get_fix_list()) {
+    if (!utils::strmatch(f->style, "^wall/gran$") && !utils::strmatch(f->style, "^wall/gran/opt$"))
+      continue;
+    auto *wall = dynamic_cast<FixWallGran *>(f);
+    if (wall && wall_gran_touch_flags(wall)) walls.push_back(wall);
+  }
   for (auto *f : modify->get_fix_list()) {
     if (f->rigid_flag) error->all(FLERR, "Fix {} cannot be used with the rigid-body fix {}", style, f->id);
     if (utils::strmatch(f->style, "^deposit") || utils::strmatch(f->style, "^pour"))
@@ -284,6 +294,7 @@ void FixSleepGran::post_force(int /*vflag*/)
     comm_mode = COMM_PUSH;
     comm->reverse_comm(this, 4);
   }
+  if (rest_rule || update->ntimestep % every == 0) count_wall_contacts();
   wake_pushed();
 
   // rest time of the awake atoms of the group (those woken now start counting next step);
@@ -368,6 +379,23 @@ void FixSleepGran::sum_contacts_and_push()
         if (asleep[j] != 0.0 && j_here) push[j][k] -= fk;
       }
     }
+  }
+}
+
+/* ----------------------------------------------------------------------
+   the wall contacts of the local atoms, on the steps whose contacts are counted (the walls'
+   post_force came before this fix's): an atom alone on the floor is at rest on something
+------------------------------------------------------------------------- */
+
+void FixSleepGran::count_wall_contacts()
+{
+  const int nvisit = nvisited();
+  for (auto *wall : walls) {
+    double **touch = wall_gran_touch_flags(wall);
+    const int *mask = atom->mask;
+    const int wallbit = wall->groupbit;
+    for (int i = 0; i < nvisit; i++)
+      if ((mask[i] & wallbit) && touch[i][0] != 0.0) ncontact[i] += 1.0;
   }
 }
 
@@ -501,7 +529,7 @@ void FixSleepGran::mark_touching_sleepers()
 /* ----------------------------------------------------------------------
    commit to sleep the atoms at rest for the rest time, and (keyword depth) those slower than
    10 x speed lying at least `depth` below the top of the bed in their column; either way only
-   atoms that touch another (a contact the pair style computed this step)
+   atoms that touch another or a granular wall (a contact counted this step)
 ------------------------------------------------------------------------- */
 
 void FixSleepGran::fall_asleep()

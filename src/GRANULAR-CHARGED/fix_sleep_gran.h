@@ -73,8 +73,10 @@ class FixSleepGran : public Fix {
   // "push" (dim 2): per atom (local and ghost), the contact force on a sleeper from its awake
   //   partners (zeroed in pre_force, summed in post_force)
   // "contacts" (dim 1): per atom (local and ghost), contacts computed this step (zeroed in
-  //   pre_force, counted in post_force; pairs of two sleepers not counted) on commit steps, and
-  //   on every step with a rest time (else 0); only an atom that touches another can fall asleep
+  //   pre_force, counted in post_force; pairs of two sleepers not counted; for a local atom also
+  //   its contacts with the walls of fix wall/gran or wall/gran/opt with a JKR model) on commit
+  //   steps, and on every step with a rest time (else 0); only an atom that touches another or
+  //   such a wall can fall asleep
   // "pairs_awake" (dim 0, int): 1 with keyword pairs awake (the pair style leaves out the pairs
   //   of two sleepers, by the flags of "sleeping"), 0 with pairs all
   // With a fix bury/gran of this fix, "push" and "contacts" hold no values for the local atoms
@@ -99,6 +101,7 @@ class FixSleepGran : public Fix {
   // atoms that fell asleep and atoms woken since the fix was defined (kept across restarts)
   bigint fallen_asleep_total, woken_total;
   class FixNeighHistory *pair_history;    // the pair style's contact flags (null: none)
+  std::vector<class FixWallGran *> walls;    // flat granular walls whose contacts count
   std::vector<double> kept_history;       // one contact's history, kept across single()
   // the entries of the pair's list with an awake atom or neighbor, and those of them with an
   // awake atom and a sleeping neighbor or the reverse (update_active_entries())
@@ -122,6 +125,7 @@ class FixSleepGran : public Fix {
   void wake_pushed();
   void hold_sleepers(bool woken_too);
   void surface_heights(std::vector<double> &top, int &nbx, int &nby) const;
+  void count_wall_contacts();
   int column_of(const double *x, int nbx, int nby) const;
   void check_fix_order();
 };

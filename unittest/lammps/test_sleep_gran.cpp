@@ -16,6 +16,8 @@
      sleeps only with a counted contact), a pushed sleeper wakes with the sleeper touching it,
      and below the threshold nothing wakes. (test_sleep_styles.cpp: the same trajectory with
      both styles.)
+   - A sphere alone on a JKR floor (fix wall/gran or wall/gran/opt) falls asleep, one at rest
+     in the air does not.
    - Bad input: every refused keyword value, a pair style other than granular[/opt], a point
      particle atom style, a fix that adds forces after it, an injection into another group.
 
@@ -27,7 +29,8 @@
    not at all, WakesWhenPushed fails; without pack_exchange of the flags the two-rank migration
    fails; without pack_restart the restart fails; with the fix's own contact count removed
    BaseStyleHoldsAndWakes fails (nothing sleeps), and with its push sum removed it fails
-   (nothing wakes). */
+   (nothing wakes); without the wall contacts counted AnAtomAloneOnTheFloorSleeps fails (no
+   sleeper). */
 #include "gc_testing.h"
 
 #include "atom.h"
@@ -443,6 +446,36 @@ TEST(FixSleepGran, DepthRuleIgnoresAClusterHoveringAboveTheBed)
   l.cmd("run 1");
   EXPECT_EQ(l.var("f_sleep[2]"), 27.0) << "the same sleepers as without the cluster";
   EXPECT_DOUBLE_EQ(l.var("c_zs"), 2 * 1.995e-6);
+}
+
+// sphere 1 rests alone on a JKR floor, sphere 2 is at rest in the air; the thresholds are met
+// by both at once. A wall contact counts as a contact: sphere 1 sleeps (a sphere that lands
+// on the floor far from the others would otherwise stay awake under a tall bed), sphere 2 does
+// not (nothing holds it)
+std::vector<std::string> alone(const std::string &pair, const std::string &wall)
+{
+  return {"units si", "atom_style sphere", "atom_modify map array", "boundary p p f", "newton off",
+          "comm_modify vel yes", "region box block 0 2e-5 0 2e-5 -1e-6 2e-5", "create_box 1 box",
+          "create_atoms 1 single 5e-6 5e-6 0 units box", "create_atoms 1 single 1.5e-5 1.5e-5 8e-6 units box",
+          "set group all diameter 2.0e-6", "set group all density 2500", "pair_style " + pair,
+          std::string("pair_coeff * * ") + MODEL,
+          "fix floor all " + wall + " granular " + MODEL + " zplane -0.999e-6 NULL",
+          "neighbor 2e-7 bin", "neigh_modify every 1 delay 0 check yes",
+          "fix integrate all nve/sphere", "timestep 5e-9", "thermo 0", ALL_SLEEP,
+          "variable idsleep atom id*f_sleep", "compute ids all reduce max v_idsleep",
+          "thermo_style custom step f_sleep[2] c_ids"};
+}
+
+TEST(FixSleepGran, AnAtomAloneOnTheFloorSleeps)
+{
+  for (const auto &[pair, wall] : {std::pair<std::string, std::string>{"granular/opt", "wall/gran/opt"},
+                                   {"granular", "wall/gran"}}) {
+    Lmp l;
+    l.cmds(alone(pair, wall));
+    l.cmd("run 1");
+    EXPECT_EQ(l.var("f_sleep[2]"), 1.0) << pair << " + " << wall << ": one sleeper";
+    EXPECT_EQ(l.var("c_ids"), 1.0) << pair << " + " << wall << ": the sphere on the floor";
+  }
 }
 
 // the bed's reach in a column, without LAMMPS: layers up to the first run of more than
