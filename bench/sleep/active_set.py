@@ -1,0 +1,73 @@
+#!/usr/bin/python3
+"""fix bury/gran's rule applied to dumps of a sleeping deposition: how many sleepers its cell
+window keeps in the group `active`, and how many it would keep if the awake atoms that touch
+no other atom and lie on the floor were asleep (they count no pair contact).
+
+The dumps hold `id x y z radius f_sleep v_act` (v_act: atom-style variable gmask(active)); a
+copy of the deck with them, every 500000 steps:
+
+    awk '{print} /"variable sleep_thermo string f_sleep"/ {print "variable act atom gmask(active)";
+         print "dump diag all custom 500000 ${out}/diag.*.dump id x y z radius f_sleep v_act"}' \\
+        python/granular_charged/decks/in.deposition > in.diag
+    lmp -in in.diag -var out OUT -var N 8000 -var L_rp 28 -var seed 1
+    bench/sleep/active_set.py HALO_RP OUT/diag.*.dump
+
+HALO_RP: fix bury/gran's halo in r_p (the deck's: max(2 r_max, coul_near r_p) + 4 r_max + 2 skin,
+7.5 for one size of particle). The cells are those of fix bury/gran: 2 r_max wide in x and y,
+r_max / 2 tall, a window of ceil(halo / cell) cells each way.
+"""
+import sys
+
+import numpy as np
+from scipy.ndimage import maximum_filter
+from scipy.spatial import cKDTree
+
+
+def read_dump(path):
+    with open(path) as f:
+        lines = f.readlines()
+    n = int(lines[3])
+    bounds = np.array([[float(v) for v in lines[5 + d].split()[:2]] for d in range(3)])
+    return bounds, np.loadtxt(lines[9:9 + n], ndmin=2)
+
+
+def main(argv):
+    if len(argv) < 3:
+        sys.exit(__doc__)
+    halo_rp = float(argv[1])
+    for path in argv[2:]:
+        bounds, a = read_dump(path)
+        n = len(a)
+        rp = a[:, 4].max()
+        prd = bounds[:, 1] - bounds[:, 0]
+        x = a[:, 1:4] - bounds[:, 0]
+        x[:, :2] %= prd[:2]
+        asleep, active = a[:, 5] != 0, a[:, 6] != 0
+        side = 2 * rp
+        ncell = np.maximum(1, (prd / np.array([side, side, 0.25 * side])).astype(int))
+        width = prd / ncell
+        k = np.maximum(1, np.ceil(halo_rp * rp / width).astype(int))
+        cell = np.minimum((x / width).astype(int), ncell - 1)
+        pairs = cKDTree(x, boxsize=[prd[0], prd[1], 1e3 * prd[2]]).query_pairs(
+            2 * rp * 1.0001, output_type='ndarray')
+        touches = np.zeros(n, bool)
+        touches[pairs.ravel()] = True
+
+        def kept(awake):
+            grid = np.zeros(ncell, bool)
+            c = cell[awake]
+            grid[c[:, 0], c[:, 1], c[:, 2]] = True
+            grid = maximum_filter(grid, size=tuple(2 * k + 1), mode=('wrap', 'wrap', 'constant'))
+            c = cell[asleep]
+            return int(grid[c[:, 0], c[:, 1], c[:, 2]].sum())
+
+        awake = ~asleep
+        loners = awake & ~touches & (x[:, 2] < 1.01 * rp)
+        print(f'{path}: {n} atoms, {awake.sum()} awake, {active.sum()} in active '
+              f'({(active & asleep).sum()} sleepers); window {k} cells; sleepers kept by the rule '
+              f'{kept(awake)}, with the {loners.sum()} lone awake atoms on the floor asleep '
+              f'{kept(awake & ~loners)}')
+
+
+if __name__ == '__main__':
+    main(sys.argv)
