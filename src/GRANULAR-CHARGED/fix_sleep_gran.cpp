@@ -277,6 +277,15 @@ int FixSleepGran::nvisited() const
   return buried_past_nfirst ? atom->nfirst : atom->nlocal;
 }
 
+/* ----------------------------------------------------------------------
+   the contacts are read on commit steps only, and on every step by the rest rule
+------------------------------------------------------------------------- */
+
+bool FixSleepGran::counting_step() const
+{
+  return rest_rule || update->ntimestep % every == 0;
+}
+
 /* ---------------------------------------------------------------------- */
 
 void FixSleepGran::exchange_flags()
@@ -294,7 +303,7 @@ void FixSleepGran::post_force(int /*vflag*/)
     comm_mode = COMM_PUSH;
     comm->reverse_comm(this, 4);
   }
-  if (rest_rule || update->ntimestep % every == 0) count_wall_contacts();
+  if (counting_step()) count_wall_contacts();
   wake_pushed();
 
   // rest time of the awake atoms of the group (those woken now start counting next step);
@@ -345,9 +354,9 @@ void FixSleepGran::sum_contacts_and_push()
   const int size_history = pair_history ? pair_history->get_dnum() : 0;
   kept_history.resize(size_history);
   update_active_entries(list);
-  // the contact counts are read on commit steps only (and each step by the rest rule); on the
-  // other steps only the pushes are summed, over the entries of awake-sleeper pairs
-  const bool count = rest_rule || update->ntimestep % every == 0;
+  // on the steps whose contacts are not counted only the pushes are summed, over the entries
+  // of awake-sleeper pairs
+  const bool count = counting_step();
   for (const int ii : count ? active_entries : interface_entries) {
     const int i = list->ilist[ii];
     const int *jlist = list->firstneigh[i];

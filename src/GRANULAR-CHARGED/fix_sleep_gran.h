@@ -111,6 +111,7 @@ class FixSleepGran : public Fix {
   bool buried_past_nfirst;
 
   int nvisited() const;
+  bool counting_step() const;    // are this step's contacts counted
 
   void exchange_flags();
   void clear_push_and_contacts();
