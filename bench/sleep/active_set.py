@@ -17,18 +17,14 @@ HALO_RP: fix bury/gran's halo in r_p (the deck's: max(2 r_max, coul_near r_p) + 
 r_max / 2 tall, a window of ceil(halo / cell) cells each way.
 """
 import sys
+from pathlib import Path
 
 import numpy as np
 from scipy.ndimage import maximum_filter
 from scipy.spatial import cKDTree
 
-
-def read_dump(path):
-    with open(path) as f:
-        lines = f.readlines()
-    n = int(lines[3])
-    bounds = np.array([[float(v) for v in lines[5 + d].split()[:2]] for d in range(3)])
-    return bounds, np.loadtxt(lines[9:9 + n], ndmin=2)
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+from granular_charged.analysis.packing import read_dump  # noqa: E402
 
 
 def main(argv):
@@ -36,13 +32,14 @@ def main(argv):
         sys.exit(__doc__)
     halo_rp = float(argv[1])
     for path in argv[2:]:
-        bounds, a = read_dump(path)
-        n = len(a)
-        rp = a[:, 4].max()
+        snap = read_dump(path, last_only=True)
+        bounds, c = snap.box, snap.cols
+        n = len(c['id'])
+        rp = c['radius'].max()
         prd = bounds[:, 1] - bounds[:, 0]
-        x = a[:, 1:4] - bounds[:, 0]
+        x = np.column_stack([c['x'], c['y'], c['z']]) - bounds[:, 0]
         x[:, :2] %= prd[:2]
-        asleep, active = a[:, 5] != 0, a[:, 6] != 0
+        asleep, active = c['f_sleep'] != 0, c['v_act'] != 0
         side = 2 * rp
         ncell = np.maximum(1, (prd / np.array([side, side, 0.25 * side])).astype(int))
         width = prd / ncell
