@@ -4,6 +4,7 @@
 // different splitting parameter and a plain (full-plane, libm cos/sin) reciprocal loop.
 #include "gcfmm/far_field.hpp"
 #include "gcfmm/lattice_sum.hpp"
+#include "gcsimd/simd.hpp"
 
 #include <gtest/gtest.h>
 
@@ -576,6 +577,54 @@ TEST(PeriodicFarField, TargetRangesAddAndAgree) {
     EXPECT_NEAR(x2[i] - 1, x1[i], 1e-13);
     EXPECT_NEAR(y2[i] - 1, y1[i], 1e-13);
     EXPECT_NEAR(z2[i] - 1, z1[i], 1e-13);
+  }
+}
+
+TEST(PeriodicFarField, SimdPathsGiveTheScalarFormulasBitForBit) {
+  // evaluate() anterpolates and interpolates many particles at once (SIMD lanes); each lane
+  // must do the scalar formulas' operations in their order, so on every path the result equals,
+  // to the last bit, evaluate_dipoles() with charges only, whose scalar loops (one particle at a
+  // time, interp_weights) are the formulas as written (its zero dipole terms add exact zeros).
+  // Particles spread over several boxes, zero charges among them, counts not a multiple of the
+  // lanes, and the parameter sets of three accuracies.
+  Config c = deposition(301, false, 31);
+  for (std::size_t i = 0; i < c.size(); i += 7) c.q[i] = 0.0;
+  const std::size_t n = c.size();
+  std::vector<gcsimd::SimdPath> paths;
+  for (auto p : {gcsimd::SimdPath::Generic, gcsimd::SimdPath::AVX2, gcsimd::SimdPath::AVX512})
+    if (gcsimd::simd_path_available(p)) paths.push_back(p);
+  for (double acc : {1e-3, 1e-4, 1e-6}) {
+    PeriodicFarField f;
+    f.setup(0, 0, 28, 28, 0, 160, 1, acc);
+    ASSERT_GE(f.boxes(), 4);
+    std::vector<double> rp(n, 0), rx(n, 0), ry(n, 0), rz(n, 0), g6(6 * n, 0);
+    f.evaluate_dipoles(n, c.x.data(), c.y.data(), c.z.data(), c.q.data(), nullptr, nullptr, nullptr, 0, n,
+                       rp.data(), rx.data(), ry.data(), rz.data(), g6.data());
+    for (auto path : paths) {
+      f.set_simd_path(path);
+      std::vector<double> pot(n, 0), ex(n, 0), ey(n, 0), ez(n, 0);
+      f.evaluate(n, c.x.data(), c.y.data(), c.z.data(), c.q.data(), 0, n, pot.data(), ex.data(), ey.data(),
+                 ez.data());
+      std::size_t differ = 0;
+      for (std::size_t i = 0; i < n; ++i)
+        differ += pot[i] != rp[i] || ex[i] != rx[i] || ey[i] != ry[i] || ez[i] != rz[i];
+      EXPECT_EQ(differ, 0u) << "path " << gcsimd::simd_path_name(path) << ", accuracy " << acc;
+      // two work partitions, each anterpolating its share of the x nodes: the same bits
+      std::vector<std::vector<double>> share(2);
+      for (int part = 0; part < 2; ++part) {
+        std::vector<double> e(n, 0);
+        f.evaluate(n, c.x.data(), c.y.data(), c.z.data(), c.q.data(), 0, n, nullptr, e.data(), e.data(),
+                   e.data(), part, 2, [&](double *w, std::size_t count) { share[part].assign(w, w + count); });
+      }
+      std::vector<double> sx(n, 0), sy(n, 0), sz(n, 0);
+      f.evaluate(n, c.x.data(), c.y.data(), c.z.data(), c.q.data(), 0, n, nullptr, sx.data(), sy.data(),
+                 sz.data(), 0, 2, [&](double *w, std::size_t count) {
+                   for (std::size_t k = 0; k < count; ++k) w[k] += share[1][k];
+                 });
+      differ = 0;
+      for (std::size_t i = 0; i < n; ++i) differ += sx[i] != rx[i] || sy[i] != ry[i] || sz[i] != rz[i];
+      EXPECT_EQ(differ, 0u) << "two partitions, path " << gcsimd::simd_path_name(path) << ", accuracy " << acc;
+    }
   }
 }
 

@@ -13,10 +13,37 @@
 #include <stdexcept>
 #include <string>
 
+#include "far_field_batch.hpp"
 #include "gcfmm/lattice_sum.hpp"
 #include "gcfmm/types.hpp"
 
 namespace gcfmm {
+
+// the per-particle arrays of one anterpolation or interpolation, kept between calls (one set
+// per thread: callers may evaluate on several threads)
+struct PeriodicFarField::FarFieldScratch {
+  std::vector<int> box_of;
+  std::vector<double> t_all;
+  std::vector<std::size_t> box_start, fill, order;
+  std::vector<double> tx, ty, tz, q, sx, dsx, sy, dsy, sz, dsz, f, gx, gy, gz;
+  int tgt_lo = 0, tgt_hi = 0;
+  // weights of n particles (and their derivatives) for p nodes in x and y, pz in z
+  void weights(std::size_t n, int p, int pz, bool derivatives) {
+    sx.resize(n * p);
+    sy.resize(n * p);
+    sz.resize(n * pz);
+    if (!derivatives) return;
+    dsx.resize(n * p);
+    dsy.resize(n * p);
+    dsz.resize(n * pz);
+  }
+};
+
+PeriodicFarField::FarFieldScratch &PeriodicFarField::far_field_scratch() {
+  thread_local FarFieldScratch scratch;
+  return scratch;
+}
+
 
 void PeriodicFarField::interp_weights(double t, int p, const double *tab, double *s, double *ds, double *d2s) {
   // Lagrange basis of the first-kind Chebyshev nodes t_i = cos(pi (2i+1) / 2p), written with
@@ -165,39 +192,34 @@ int PeriodicFarField::locate(std::size_t i, double x, double y, double z, double
 void PeriodicFarField::interpolate(const double *phi, const double *x, const double *y,
                                    const double *z, std::size_t begin, std::size_t end, double *pot,
                                    double *ex, double *ey, double *ez) const {
+  if (end <= begin) return;
   const int p = pxy_, pz = pz_;
-  double sx[32], sy[32], sz[32], dsx[32], dsy[32], dsz[32];
+  const std::size_t n = end - begin;
+  FarFieldScratch &sc = far_field_scratch();
+  sort_by_box(begin, end, x, y, z, nullptr, sc);
+  sc.weights(n, p, pz, true);
+  detail::chebyshev_weights(simd_path_, n, sc.tx.data(), p, tab_xy_.data(), n, sc.sx.data(), sc.dsx.data());
+  detail::chebyshev_weights(simd_path_, n, sc.ty.data(), p, tab_xy_.data(), n, sc.sy.data(), sc.dsy.data());
+  detail::chebyshev_weights(simd_path_, n, sc.tz.data(), pz, tab_z_.data(), n, sc.sz.data(), sc.dsz.data());
+  sc.f.resize(n);
+  sc.gx.resize(n);
+  sc.gy.resize(n);
+  sc.gz.resize(n);
+  for (int b = 0; b < nb_; ++b) {
+    const std::size_t r0 = sc.box_start[b], r1 = sc.box_start[b + 1];
+    if (r1 == r0) continue;
+    detail::interpolate_box(simd_path_, r1 - r0, p, pz, phi + static_cast<std::size_t>(b) * p * p * pz,
+                            sc.sx.data() + r0, sc.dsx.data() + r0, sc.sy.data() + r0, sc.dsy.data() + r0,
+                            sc.sz.data() + r0, sc.dsz.data() + r0, n, sc.f.data() + r0, sc.gx.data() + r0,
+                            sc.gy.data() + r0, sc.gz.data() + r0);
+  }
   const double fx = 2.0 / lx_, fy = 2.0 / ly_, fz = 2.0 / hz_;
-  for (std::size_t i = begin; i < end; ++i) {
-    double tx, ty, tz;
-    const int b = locate(i, x[i], y[i], z[i], &tx, &ty, &tz);
-    interp_weights(tx, p, tab_xy_.data(), sx, dsx);
-    interp_weights(ty, p, tab_xy_.data(), sy, dsy);
-    interp_weights(tz, pz, tab_z_.data(), sz, dsz);
-    const double *col = phi + static_cast<std::size_t>(b) * p * p * pz;
-    double f = 0, gx = 0, gy = 0, gz = 0;
-    for (int a = 0; a < p; ++a) {
-      double fa = 0, fya = 0, fza = 0;
-      for (int bb = 0; bb < p; ++bb) {
-        const double *src = col + (a * p + bb) * pz;
-        double v = 0, vz = 0;
-        for (int c = 0; c < pz; ++c) {
-          v += sz[c] * src[c];
-          vz += dsz[c] * src[c];
-        }
-        fa += sy[bb] * v;
-        fya += dsy[bb] * v;
-        fza += sy[bb] * vz;
-      }
-      f += sx[a] * fa;
-      gx += dsx[a] * fa;
-      gy += sx[a] * fya;
-      gz += sx[a] * fza;
-    }
-    if (pot) pot[i] += f;
-    ex[i] -= fx * gx;
-    ey[i] -= fy * gy;
-    ez[i] -= fz * gz;
+  for (std::size_t r = 0; r < n; ++r) {
+    const std::size_t i = sc.order[r];
+    if (pot) pot[i] += sc.f[r];
+    ex[i] -= fx * sc.gx[r];
+    ey[i] -= fy * sc.gy[r];
+    ez[i] -= fz * sc.gz[r];
   }
 }
 
@@ -377,31 +399,74 @@ void PeriodicFarField::anterpolate(std::size_t n, const double *x, const double 
                                    const double *q, int a0, int a1, std::vector<double> &w, int *src_lo,
                                    int *src_hi, int *tgt_lo, int *tgt_hi) const {
   const int p = pxy_, pz = pz_, nn = p * p * pz;
-  double sx[32], sy[32], sz[32];
   w.assign(static_cast<std::size_t>(nn) * nb_, 0.0);
-  *src_lo = *tgt_lo = nb_;
-  *src_hi = *tgt_hi = 0;
-  for (std::size_t j = 0; j < n; ++j) {
-    double tx, ty, tz;
-    const int b = locate(j, x[j], y[j], z[j], &tx, &ty, &tz);
-    *tgt_lo = std::min(*tgt_lo, b);
-    *tgt_hi = std::max(*tgt_hi, b + 1);
-    if (q[j] == 0.0) continue;
-    *src_lo = std::min(*src_lo, b);
-    *src_hi = std::max(*src_hi, b + 1);
-    if (a0 == a1) continue;
-    interp_weights(tx, p, tab_xy_.data(), sx, nullptr);
-    interp_weights(ty, p, tab_xy_.data(), sy, nullptr);
-    interp_weights(tz, pz, tab_z_.data(), sz, nullptr);
-    double *col = w.data() + static_cast<std::size_t>(nn) * b;
-    for (int a = a0; a < a1; ++a) {
-      const double qa = q[j] * sx[a];
-      for (int bb = 0; bb < p; ++bb) {
-        const double qab = qa * sy[bb];
-        double *dst = col + (a * p + bb) * pz;
-        for (int c = 0; c < pz; ++c) dst[c] += qab * sz[c];
-      }
+  FarFieldScratch &sc = far_field_scratch();
+  // every particle is located (and checked); the charged ones are kept, in their order per box
+  sort_by_box(0, n, x, y, z, q, sc);
+  *tgt_lo = sc.tgt_lo;
+  *tgt_hi = sc.tgt_hi;
+  *src_lo = nb_;
+  *src_hi = 0;
+  for (int b = 0; b < nb_; ++b)
+    if (sc.box_start[b + 1] > sc.box_start[b]) {
+      *src_lo = std::min(*src_lo, b);
+      *src_hi = b + 1;
     }
+  const std::size_t m = sc.order.size();
+  if (a0 == a1 || m == 0) return;
+  sc.weights(m, p, pz, false);
+  detail::chebyshev_weights(simd_path_, m, sc.tx.data(), p, tab_xy_.data(), m, sc.sx.data(), nullptr);
+  detail::chebyshev_weights(simd_path_, m, sc.ty.data(), p, tab_xy_.data(), m, sc.sy.data(), nullptr);
+  detail::chebyshev_weights(simd_path_, m, sc.tz.data(), pz, tab_z_.data(), m, sc.sz.data(), nullptr);
+  for (int b = *src_lo; b < *src_hi; ++b) {
+    const std::size_t r0 = sc.box_start[b], r1 = sc.box_start[b + 1];
+    if (r1 == r0) continue;
+    detail::anterpolate_box(simd_path_, r1 - r0, sc.q.data() + r0, p, pz, a0, a1, sc.sx.data() + r0,
+                            sc.sy.data() + r0, sc.sz.data() + r0, m, w.data() + static_cast<std::size_t>(nn) * b);
+  }
+}
+
+// the particles [begin, end) (with q: those with a nonzero charge) in the order of their boxes,
+// each box's in their own order (a stable counting sort): their reference coordinates, index and
+// charge, where each box's run starts, and the boxes holding any of [begin, end)
+void PeriodicFarField::sort_by_box(std::size_t begin, std::size_t end, const double *x, const double *y,
+                                   const double *z, const double *q, FarFieldScratch &sc) const {
+  const std::size_t n = end - begin;
+  sc.box_of.resize(n);
+  sc.t_all.resize(3 * n);
+  sc.box_start.assign(static_cast<std::size_t>(nb_) + 1, 0);
+  sc.tgt_lo = nb_;
+  sc.tgt_hi = 0;
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = begin + k;
+    const int b = locate(i, x[i], y[i], z[i], &sc.t_all[3 * k], &sc.t_all[3 * k + 1], &sc.t_all[3 * k + 2]);
+    sc.tgt_lo = std::min(sc.tgt_lo, b);
+    sc.tgt_hi = std::max(sc.tgt_hi, b + 1);
+    if (q && q[i] == 0.0) {
+      sc.box_of[k] = -1;
+      continue;
+    }
+    sc.box_of[k] = b;
+    ++sc.box_start[b + 1];
+    ++kept;
+  }
+  for (int b = 0; b < nb_; ++b) sc.box_start[b + 1] += sc.box_start[b];
+  sc.order.resize(kept);
+  sc.tx.resize(kept);
+  sc.ty.resize(kept);
+  sc.tz.resize(kept);
+  if (q) sc.q.resize(kept);
+  sc.fill.assign(sc.box_start.begin(), sc.box_start.end() - 1);
+  for (std::size_t k = 0; k < n; ++k) {
+    const int b = sc.box_of[k];
+    if (b < 0) continue;
+    const std::size_t r = sc.fill[b]++;
+    sc.order[r] = begin + k;
+    sc.tx[r] = sc.t_all[3 * k];
+    sc.ty[r] = sc.t_all[3 * k + 1];
+    sc.tz[r] = sc.t_all[3 * k + 2];
+    if (q) sc.q[r] = q[begin + k];
   }
 }
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "gcfmm/types.hpp"
+#include "gcsimd/simd.hpp"
 
 namespace gcfmm {
 
@@ -178,6 +179,11 @@ class PeriodicFarField {
   /// @brief Choice of (p, pz, hz / min(lx, ly)) for a requested accuracy (used by setup).
   static void parameters_for(double accuracy, int *pxy, int *pz, double *hz_over_l);
 
+  /// @brief Instruction-set path of the per-particle work (anterpolation, interpolation);
+  /// every path gives the same result bit for bit. Default: gcsimd::default_simd_path().
+  void set_simd_path(gcsimd::SimdPath path) { simd_path_ = path; }
+  gcsimd::SimdPath simd_path() const { return simd_path_; }
+
   /// @brief Setup with explicit interpolation parameters (tests and tuning).
   void setup_explicit(double x0, double y0, double lx, double ly, double zlo, double zhi,
                       int images, int pxy, int pz, double hz_max);
@@ -196,6 +202,11 @@ class PeriodicFarField {
   void interpolate_gradient(const double *phi, const double *x, const double *y, const double *z, std::size_t begin,
                             std::size_t end, double *pot, double *ex, double *ey, double *ez, double *g6) const;
   int locate(std::size_t i, double x, double y, double z, double *tx, double *ty, double *tz) const;
+  // per-thread work arrays of anterpolate() and interpolate(), and the particles sorted by box
+  struct FarFieldScratch;
+  static FarFieldScratch &far_field_scratch();
+  void sort_by_box(std::size_t begin, std::size_t end, const double *x, const double *y, const double *z,
+                   const double *q, FarFieldScratch &scratch) const;
   void interpolate(const double *phi, const double *x, const double *y, const double *z,
                    std::size_t begin, std::size_t end, double *pot, double *ex, double *ey,
                    double *ez) const;
@@ -221,6 +232,7 @@ class PeriodicFarField {
                                               //!< or U (nh x r) then W (r x nh) where rank_ < nh
   std::vector<int> rank_;                     //!< rank of each stored block (nh: dense)
   std::vector<double> tab_xy_, tab_z_;        //!< T_k(t_i) at the Chebyshev nodes
+  gcsimd::SimdPath simd_path_ = gcsimd::default_simd_path();  //!< path of the per-particle work
 };
 
 }  // namespace gcfmm
