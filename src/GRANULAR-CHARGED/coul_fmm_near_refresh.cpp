@@ -269,6 +269,10 @@ void CoulFMMNearRefresh::hold_pairs(const MTS &scheme, const CoulFMMState &state
         const double r2then = then[0] * then[0] + then[1] * then[1] + then[2] * then[2];
         if (r2then == 0.0) return;
         if (r2then < cutsq) near_mine += near_pair_weight(j, atom->nlocal);
+        // two static sources (sleepers of fix sleep/gran at the evaluation): neither moves until
+        // one wakes, which forces an evaluation, and no slope covers them, so the pair's change
+        // is zero to the last bit; left out of the held pairs, still counted above
+        if (delta[i][MTS::DELTA_STATIC] != 0.0 && delta[j][MTS::DELTA_STATIC] != 0.0) return;
         HeldPair h;
         h.j = j;
         h.qi_then = delta[i][MTS::DELTA_Q];

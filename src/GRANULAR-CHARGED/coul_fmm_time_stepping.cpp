@@ -207,6 +207,7 @@ void CoulFMMTimeStepping::displacements(const double xu[3], const double *state,
   }
   delta[DELTA_IN_SLOPE] = state[IN_SLOPE];
   delta[DELTA_Q] = state[Q];
+  delta[DELTA_STATIC] = state[ASLEEP];
 }
 
 /* ----------------------------------------------------------------------

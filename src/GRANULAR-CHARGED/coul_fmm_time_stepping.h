@@ -42,15 +42,17 @@ class CoulFMMTimeStepping {
   static constexpr int COLS_V1 = 22;
 
   // one atom's displacements for the near refresh (local atoms and ghosts): since the
-  // evaluation, since the two evaluations of the slope, whether the slope covers it, and its
-  // charge at the evaluation (the change of an absorbed charge, eq. (5.5))
+  // evaluation, since the two evaluations of the slope, whether the slope covers it, its
+  // charge at the evaluation (the change of an absorbed charge, eq. (5.5)) and whether it was a
+  // static source then (ASLEEP)
   enum Delta : int {
     DELTA_E = 0,
     DELTA_A = 3,
     DELTA_B = 6,
     DELTA_IN_SLOPE = 9,
     DELTA_Q = 10,
-    DELTA_COLS = 11
+    DELTA_STATIC = 11,
+    DELTA_COLS = 12
   };
 
   // the keywords of the scheme, checked once by validate()
