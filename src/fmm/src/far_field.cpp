@@ -44,7 +44,6 @@ PeriodicFarField::FarFieldScratch &PeriodicFarField::far_field_scratch() {
   return scratch;
 }
 
-
 void PeriodicFarField::interp_weights(double t, int p, const double *tab, double *s, double *ds, double *d2s) {
   // Lagrange basis of the first-kind Chebyshev nodes t_i = cos(pi (2i+1) / 2p), written with
   // the discrete orthogonality of T_k: S_i(t) = 1/p + (2/p) sum_{k=1}^{p-1} T_k(t_i) T_k(t),
