@@ -45,39 +45,7 @@ PeriodicFarField::FarFieldScratch &PeriodicFarField::far_field_scratch() {
 }
 
 void PeriodicFarField::interp_weights(double t, int p, const double *tab, double *s, double *ds, double *d2s) {
-  // Lagrange basis of the first-kind Chebyshev nodes t_i = cos(pi (2i+1) / 2p), written with
-  // the discrete orthogonality of T_k: S_i(t) = 1/p + (2/p) sum_{k=1}^{p-1} T_k(t_i) T_k(t),
-  // S_i'(t) = (2/p) sum_k T_k(t_i) k U_{k-1}(t). Stable everywhere on [-1, 1] and slightly beyond.
-  // Second derivatives by the differentiated recurrence T_k'' = 4 T_{k-1}' + 2 t T_{k-1}'' - T_{k-2}''.
-  double tk[32], dtk[32], d2tk[32];
-  tk[0] = 1.0;
-  dtk[0] = d2tk[0] = 0.0;
-  if (p > 1) {
-    tk[1] = t;
-    dtk[1] = 1.0;
-    d2tk[1] = 0.0;
-  }
-  double um1 = 1.0, u = 2.0 * t;  // U_0, U_1
-  for (int k = 2; k < p; ++k) {
-    tk[k] = 2.0 * t * tk[k - 1] - tk[k - 2];
-    dtk[k] = k * u;  // T_k' = k U_{k-1}
-    d2tk[k] = 4.0 * dtk[k - 1] + 2.0 * t * d2tk[k - 1] - d2tk[k - 2];
-    const double un = 2.0 * t * u - um1;
-    um1 = u;
-    u = un;
-  }
-  for (int i = 0; i < p; ++i) {
-    const double *ti = tab + static_cast<std::size_t>(i) * p;
-    double a = 0.5, b = 0.0, c = 0.0;
-    for (int k = 1; k < p; ++k) {
-      a += ti[k] * tk[k];
-      b += ti[k] * dtk[k];
-      c += ti[k] * d2tk[k];
-    }
-    s[i] = 2.0 * a / p;
-    if (ds) ds[i] = 2.0 * b / p;
-    if (d2s) d2s[i] = 2.0 * c / p;
-  }
+  detail::chebyshev_lagrange_weights<double>(t, p, tab, s, ds, d2s);
 }
 
 namespace {

@@ -35,8 +35,7 @@ GCSIMD_ALWAYS_INLINE void store_lanes(const Lanes &v, double *row, std::size_t k
   for (int l = 0; l < m; ++l) row[k0 + l] = v[l];
 }
 
-// PeriodicFarField::interp_weights for the points t, kLanes at a time: the Chebyshev
-// recurrences T_k, T_k' = k U_{k-1}, then S_i = 2 (1/2 + sum_k T_k(t_i) T_k) / p
+// chebyshev_lagrange_weights for the points t, kLanes at a time
 template <int kLanes>
 GCSIMD_ALWAYS_INLINE void weights_loop(std::size_t n, const double *__restrict t, int p,
                                        const double *__restrict tab, std::size_t stride, double *__restrict s,
@@ -44,31 +43,12 @@ GCSIMD_ALWAYS_INLINE void weights_loop(std::size_t n, const double *__restrict t
   typedef typename LanesOf<kLanes>::type Lanes;
   for (std::size_t k0 = 0; k0 < n; k0 += kLanes) {
     const int m = static_cast<int>(std::min<std::size_t>(kLanes, n - k0));
-    Lanes tl;
+    Lanes tl, sl[kMaxNodes], dsl[kMaxNodes];
     load_lanes(tl, t, k0, m);
-    Lanes tk[kMaxNodes], dtk[kMaxNodes];
-    tk[0] = Lanes{} + 1.0;
-    dtk[0] = Lanes{};
-    tk[1] = tl;
-    dtk[1] = Lanes{} + 1.0;
-    Lanes um1 = Lanes{} + 1.0, u = 2.0 * tl;
-    for (int k = 2; k < p; ++k) {
-      tk[k] = 2.0 * tl * tk[k - 1] - tk[k - 2];
-      dtk[k] = static_cast<double>(k) * u;
-      const Lanes un = 2.0 * tl * u - um1;
-      um1 = u;
-      u = un;
-    }
-    const double pd = p;
+    chebyshev_lagrange_weights<Lanes>(tl, p, tab, sl, ds ? dsl : nullptr, nullptr);
     for (int i = 0; i < p; ++i) {
-      const double *ti = tab + static_cast<std::size_t>(i) * p;
-      Lanes a = Lanes{} + 0.5, b = Lanes{};
-      for (int k = 1; k < p; ++k) {
-        a += ti[k] * tk[k];
-        b += ti[k] * dtk[k];
-      }
-      store_lanes(2.0 * a / pd, s + static_cast<std::size_t>(i) * stride, k0, m);
-      if (ds) store_lanes(2.0 * b / pd, ds + static_cast<std::size_t>(i) * stride, k0, m);
+      store_lanes(sl[i], s + static_cast<std::size_t>(i) * stride, k0, m);
+      if (ds) store_lanes(dsl[i], ds + static_cast<std::size_t>(i) * stride, k0, m);
     }
   }
 }

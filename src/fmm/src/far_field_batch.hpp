@@ -8,7 +8,7 @@
 
 #include <cstddef>
 
-#include "gcsimd/simd.hpp"
+#include "gcsimd/simd_paths.hpp"
 
 namespace gcfmm {
 namespace detail {
@@ -17,9 +17,52 @@ namespace detail {
 constexpr int kFarFieldMaxNodes = 32;
 
 /**
+ * @brief The Lagrange weights of the p first-kind Chebyshev nodes t_i = cos(pi (2i+1) / 2p) at
+ * t, with tab[i * p + k] = T_k(t_i): S_i(t) = 1/p + (2/p) sum_{k=1}^{p-1} T_k(t_i) T_k(t) (the
+ * discrete orthogonality of the T_k; stable on [-1, 1] and slightly beyond), S_i' from
+ * T_k' = k U_{k-1} and S_i'' from T_k'' = 4 T_{k-1}' + 2 t T_{k-1}'' - T_{k-2}''. T is double
+ * (one point: PeriodicFarField's scalar paths) or a vector of them (one point per SIMD lane:
+ * far_field_batch.cpp), with the same operations in the same order. ds and d2s may be null.
+ */
+template <class T>
+GCSIMD_ALWAYS_INLINE void chebyshev_lagrange_weights(T t, int p, const double *tab, T *s, T *ds, T *d2s) {
+  const T zero = T{}, one = T{} + 1.0;
+  T tk[kFarFieldMaxNodes], dtk[kFarFieldMaxNodes], d2tk[kFarFieldMaxNodes];
+  tk[0] = one;
+  dtk[0] = d2tk[0] = zero;
+  if (p > 1) {
+    tk[1] = t;
+    dtk[1] = one;
+    d2tk[1] = zero;
+  }
+  T um1 = one, u = 2.0 * t;    // U_0, U_1
+  for (int k = 2; k < p; ++k) {
+    tk[k] = 2.0 * t * tk[k - 1] - tk[k - 2];
+    dtk[k] = static_cast<double>(k) * u;
+    if (d2s) d2tk[k] = 4.0 * dtk[k - 1] + 2.0 * t * d2tk[k - 1] - d2tk[k - 2];
+    const T un = 2.0 * t * u - um1;
+    um1 = u;
+    u = un;
+  }
+  const double pd = p;
+  for (int i = 0; i < p; ++i) {
+    const double *ti = tab + static_cast<std::size_t>(i) * p;
+    T a = T{} + 0.5, b = zero, c = zero;
+    for (int k = 1; k < p; ++k) {
+      a += ti[k] * tk[k];
+      if (ds) b += ti[k] * dtk[k];
+      if (d2s) c += ti[k] * d2tk[k];
+    }
+    s[i] = 2.0 * a / pd;
+    if (ds) ds[i] = 2.0 * b / pd;
+    if (d2s) d2s[i] = 2.0 * c / pd;
+  }
+}
+
+/**
  * @brief Lagrange weights of the p first-kind Chebyshev nodes at n points t[k] in [-1, 1]:
  * s[i * stride + k] = S_i(t_k) and, if ds is not null, ds[i * stride + k] = S_i'(t_k), with
- * tab[i * p + k] = T_k(t_i) (the formula of PeriodicFarField::interp_weights, bit for bit).
+ * tab[i * p + k] = T_k(t_i) (chebyshev_lagrange_weights, one point per lane).
  */
 void chebyshev_weights(gcsimd::SimdPath path, std::size_t n, const double *t, int p, const double *tab,
                        std::size_t stride, double *s, double *ds);
