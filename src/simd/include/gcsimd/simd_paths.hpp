@@ -20,43 +20,34 @@
 #endif
 
 // Defines `ret name##_generic(params)`, `name##_avx2`, `name##_avx512` (the latter two only on
-// x86 with GCC/Clang), each calling the always-inlined `body(args)` compiled for its ISA, and
-// `name##_for(SimdPath)` returning the function of a path (Generic where a path is missing).
+// x86 with GCC/Clang), each calling its always-inlined body (generic, avx2, avx512) with `args`,
+// compiled for its ISA, and `name##_for(SimdPath)` returning the function of a path (Generic
+// where a path is missing).
 #if GCSIMD_X86_DISPATCH
-#define GCSIMD_DEFINE_PATHS(ret, name, params, body, args)                 \
-  ret name##_generic params { return body args; }                              \
-  GCSIMD_TARGET_AVX2 ret name##_avx2 params { return body args; }               \
-  GCSIMD_TARGET_AVX512 ret name##_avx512 params { return body args; }           \
+#define GCSIMD_DEFINE_PATH_BODIES(ret, name, params, generic, avx2, avx512, args) \
+  ret name##_generic params { return generic args; }                           \
+  GCSIMD_TARGET_AVX2 ret name##_avx2 params { return avx2 args; }               \
+  GCSIMD_TARGET_AVX512 ret name##_avx512 params { return avx512 args; }         \
   using name##_fn = ret(*) params;                                             \
   inline name##_fn name##_for(::gcsimd::SimdPath p) {                           \
     return p == ::gcsimd::SimdPath::AVX512 ? name##_avx512                      \
            : p == ::gcsimd::SimdPath::AVX2 ? name##_avx2 : name##_generic;      \
   }
 #else
-#define GCSIMD_DEFINE_PATHS(ret, name, params, body, args)                 \
-  ret name##_generic params { return body args; }                              \
+#define GCSIMD_DEFINE_PATH_BODIES(ret, name, params, generic, avx2, avx512, args) \
+  ret name##_generic params { return generic args; }                           \
   using name##_fn = ret(*) params;                                             \
   inline name##_fn name##_for(::gcsimd::SimdPath) { return name##_generic; }
 #endif
 
-// As GCSIMD_DEFINE_PATHS for a body template over the width W of the path's registers in
-// doubles (2 generic, 4 AVX2, 8 AVX-512): kernels whose lanes are GCC/Clang vector-extension
-// types of W doubles, which a narrower ISA would split and spill
-#if GCSIMD_X86_DISPATCH
+// one body for every path
+#define GCSIMD_DEFINE_PATHS(ret, name, params, body, args)                 \
+  GCSIMD_DEFINE_PATH_BODIES(ret, name, params, body, body, body, args)
+
+// a body template over the width W of the path's registers in doubles (2 generic, 4 AVX2, 8
+// AVX-512): kernels whose lanes are GCC/Clang vector-extension types of W doubles, which a
+// narrower ISA would split and spill
 #define GCSIMD_DEFINE_WIDTH_PATHS(ret, name, params, body, args)           \
-  ret name##_generic params { return body<2> args; }                           \
-  GCSIMD_TARGET_AVX2 ret name##_avx2 params { return body<4> args; }            \
-  GCSIMD_TARGET_AVX512 ret name##_avx512 params { return body<8> args; }        \
-  using name##_fn = ret(*) params;                                             \
-  inline name##_fn name##_for(::gcsimd::SimdPath p) {                           \
-    return p == ::gcsimd::SimdPath::AVX512 ? name##_avx512                      \
-           : p == ::gcsimd::SimdPath::AVX2 ? name##_avx2 : name##_generic;      \
-  }
-#else
-#define GCSIMD_DEFINE_WIDTH_PATHS(ret, name, params, body, args)           \
-  ret name##_generic params { return body<2> args; }                           \
-  using name##_fn = ret(*) params;                                             \
-  inline name##_fn name##_for(::gcsimd::SimdPath) { return name##_generic; }
-#endif
+  GCSIMD_DEFINE_PATH_BODIES(ret, name, params, body<2>, body<4>, body<8>, args)
 
 #endif
