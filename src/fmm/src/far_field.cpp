@@ -203,47 +203,19 @@ void PeriodicFarField::interpolate_gradient(const double *phi, const double *x, 
     interp_weights(ty, p, tab_xy_.data(), sy, dsy, d2sy);
     interp_weights(tz, pz, tab_z_.data(), sz, dsz, d2sz);
     const double *col = phi + static_cast<std::size_t>(b) * p * p * pz;
-    // derivatives of the interpolant in the reference coordinates t: f, f_x, ..., f_zz
-    double f = 0, gx = 0, gy = 0, gz = 0, hxx = 0, hxy = 0, hxz = 0, hyy = 0, hyz = 0, hzz = 0;
-    for (int a = 0; a < p; ++a) {
-      double fa = 0, fya = 0, fyya = 0, fza = 0, fyza = 0, fzza = 0;
-      for (int bb = 0; bb < p; ++bb) {
-        const double *src = col + (a * p + bb) * pz;
-        double v = 0, vz = 0, vzz = 0;
-        for (int c = 0; c < pz; ++c) {
-          v += sz[c] * src[c];
-          vz += dsz[c] * src[c];
-          vzz += d2sz[c] * src[c];
-        }
-        fa += sy[bb] * v;
-        fya += dsy[bb] * v;
-        fyya += d2sy[bb] * v;
-        fza += sy[bb] * vz;
-        fyza += dsy[bb] * vz;
-        fzza += sy[bb] * vzz;
-      }
-      f += sx[a] * fa;
-      gx += dsx[a] * fa;
-      hxx += d2sx[a] * fa;
-      gy += sx[a] * fya;
-      hxy += dsx[a] * fya;
-      hyy += sx[a] * fyya;
-      gz += sx[a] * fza;
-      hxz += dsx[a] * fza;
-      hyz += sx[a] * fyza;
-      hzz += sx[a] * fzza;
-    }
-    if (pot) pot[i] += f;
-    ex[i] -= fx * gx;
-    ey[i] -= fy * gy;
-    ez[i] -= fz * gz;
+    // derivatives of the interpolant in the reference coordinates t
+    const auto d = detail::contract_interpolant<true, double>(p, pz, col, sx, dsx, d2sx, sy, dsy, d2sy, sz, dsz, d2sz);
+    if (pot) pot[i] += d.f;
+    ex[i] -= fx * d.gx;
+    ey[i] -= fy * d.gy;
+    ez[i] -= fz * d.gz;
     double *g = g6 + 6 * i;  // G = -Hessian of the potential
-    g[0] -= fx * fx * hxx;
-    g[1] -= fx * fy * hxy;
-    g[2] -= fx * fz * hxz;
-    g[3] -= fy * fy * hyy;
-    g[4] -= fy * fz * hyz;
-    g[5] -= fz * fz * hzz;
+    g[0] -= fx * fx * d.hxx;
+    g[1] -= fx * fy * d.hxy;
+    g[2] -= fx * fz * d.hxz;
+    g[3] -= fy * fy * d.hyy;
+    g[4] -= fy * fz * d.hyz;
+    g[5] -= fz * fz * d.hzz;
   }
 }
 

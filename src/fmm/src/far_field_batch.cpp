@@ -74,8 +74,8 @@ GCSIMD_ALWAYS_INLINE void anterpolate_loop(std::size_t m, const double *__restri
   }
 }
 
-// the scalar interpolation's loops (PeriodicFarField::interpolate_gradient without the second
-// derivatives) for kLanes particles side by side; empty lanes of a last block have zero weights
+// the interpolation (contract_interpolant without the second derivatives) for kLanes particles
+// side by side; empty lanes of a last block have zero weights
 template <int kLanes>
 GCSIMD_ALWAYS_INLINE void interpolate_loop(std::size_t m, int p, int pz, const double *__restrict col,
                                            const double *__restrict sx, const double *__restrict dsx,
@@ -97,29 +97,12 @@ GCSIMD_ALWAYS_INLINE void interpolate_loop(std::size_t m, int p, int pz, const d
       load_lanes(wz[c], sz + static_cast<std::size_t>(c) * stride, k0, nl);
       load_lanes(dwz[c], dsz + static_cast<std::size_t>(c) * stride, k0, nl);
     }
-    Lanes f = {}, gx = {}, gy = {}, gz = {};
-    for (int a = 0; a < p; ++a) {
-      Lanes fa = {}, fya = {}, fza = {};
-      for (int bb = 0; bb < p; ++bb) {
-        const double *src = col + static_cast<std::size_t>(a * p + bb) * pz;
-        Lanes v = {}, vz = {};
-        for (int c = 0; c < pz; ++c) {
-          v += wz[c] * src[c];
-          vz += dwz[c] * src[c];
-        }
-        fa += wy[bb] * v;
-        fya += dwy[bb] * v;
-        fza += wy[bb] * vz;
-      }
-      f += wx[a] * fa;
-      gx += dwx[a] * fa;
-      gy += wx[a] * fya;
-      gz += wx[a] * fza;
-    }
-    store_lanes(f, fo, k0, nl);
-    store_lanes(gx, gxo, k0, nl);
-    store_lanes(gy, gyo, k0, nl);
-    store_lanes(gz, gzo, k0, nl);
+    const auto d = contract_interpolant<false, Lanes>(p, pz, col, wx, dwx, nullptr, wy, dwy, nullptr, wz, dwz,
+                                                      nullptr);
+    store_lanes(d.f, fo, k0, nl);
+    store_lanes(d.gx, gxo, k0, nl);
+    store_lanes(d.gy, gyo, k0, nl);
+    store_lanes(d.gz, gzo, k0, nl);
   }
 }
 

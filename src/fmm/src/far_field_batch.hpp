@@ -59,6 +59,62 @@ GCSIMD_ALWAYS_INLINE void chebyshev_lagrange_weights(T t, int p, const double *t
   }
 }
 
+//! The interpolant's value and derivatives in a box's coordinates, from one box's node values.
+template <class T>
+struct InterpolantDerivatives {
+  T f, gx, gy, gz;                      // value and gradient
+  T hxx, hxy, hxz, hyy, hyz, hzz;       // second derivatives (kHessian only)
+};
+
+/**
+ * @brief Contracts the node values col of one box (p x p x pz, z fastest) with the weights of a
+ * point and their derivatives (as chebyshev_lagrange_weights writes them): f = sum sx_a sy_b
+ * sz_c col(a, b, c), its gradient and, with kHessian, its second derivatives. T is double (one
+ * point) or a vector of them (one point per SIMD lane), with the same operations in the same
+ * order; the second-derivative sums are separate accumulators, so they do not change the others.
+ * Without kHessian d2sx, d2sy, d2sz are not read.
+ */
+template <bool kHessian, class T>
+GCSIMD_ALWAYS_INLINE InterpolantDerivatives<T> contract_interpolant(int p, int pz, const double *col, const T *sx,
+                                                                   const T *dsx, const T *d2sx, const T *sy,
+                                                                   const T *dsy, const T *d2sy, const T *sz,
+                                                                   const T *dsz, const T *d2sz) {
+  T f{}, gx{}, gy{}, gz{}, hxx{}, hxy{}, hxz{}, hyy{}, hyz{}, hzz{};    // locals: kept in registers
+  for (int a = 0; a < p; ++a) {
+    T fa{}, fya{}, fyya{}, fza{}, fyza{}, fzza{};
+    for (int bb = 0; bb < p; ++bb) {
+      const double *src = col + static_cast<std::size_t>(a * p + bb) * pz;
+      T v{}, vz{}, vzz{};
+      for (int c = 0; c < pz; ++c) {
+        v += sz[c] * src[c];
+        vz += dsz[c] * src[c];
+        if constexpr (kHessian) vzz += d2sz[c] * src[c];
+      }
+      fa += sy[bb] * v;
+      fya += dsy[bb] * v;
+      fza += sy[bb] * vz;
+      if constexpr (kHessian) {
+        fyya += d2sy[bb] * v;
+        fyza += dsy[bb] * vz;
+        fzza += sy[bb] * vzz;
+      }
+    }
+    f += sx[a] * fa;
+    gx += dsx[a] * fa;
+    gy += sx[a] * fya;
+    gz += sx[a] * fza;
+    if constexpr (kHessian) {
+      hxx += d2sx[a] * fa;
+      hxy += dsx[a] * fya;
+      hyy += sx[a] * fyya;
+      hxz += dsx[a] * fza;
+      hyz += sx[a] * fyza;
+      hzz += sx[a] * fzza;
+    }
+  }
+  return {f, gx, gy, gz, hxx, hxy, hxz, hyy, hyz, hzz};
+}
+
 /**
  * @brief Lagrange weights of the p first-kind Chebyshev nodes at n points t[k] in [-1, 1]:
  * s[i * stride + k] = S_i(t_k) and, if ds is not null, ds[i * stride + k] = S_i'(t_k), with
