@@ -583,8 +583,10 @@ TEST(PeriodicFarField, TargetRangesAddAndAgree) {
 TEST(PeriodicFarField, SimdPathsGiveTheScalarFormulasBitForBit) {
   // evaluate() anterpolates and interpolates many particles at once (SIMD lanes); each lane
   // must do the scalar formulas' operations in their order, so on every path the result equals,
-  // to the last bit, evaluate_dipoles() with charges only, whose scalar loops (one particle at a
-  // time, interp_weights) are the formulas as written (its zero dipole terms add exact zeros).
+  // to the last bit, evaluate_dipoles() with charges only, which takes one particle at a time
+  // (its zero dipole terms add exact zeros). The two share the weights' and the contraction's
+  // templates; what this compares is their use in lanes: the sort by box, the blocks and their
+  // padding, the anterpolation's order.
   // Particles spread over several boxes, zero charges among them, counts not a multiple of the
   // lanes, and the parameter sets of three accuracies.
   Config c = deposition(301, false, 31);
