@@ -3,8 +3,9 @@
 # demo size run one after the other with one build, printing user CPU, steps and us per step of
 #   neutral          q 0 (rain, the neutral protocol)
 #   neutral-plane    q 0 with the charged runs' protocol (plane injection, gap 2)
-#   neutral-ghost    as neutral-plane with the ghost cutoff fix coul/fmm sets for near 3 r_p
-#                    (3 r_p + skin; the deck copied with a comm_modify cutoff line)
+#   neutral-ghost    as neutral-plane with the ghost cutoff fix coul/fmm sets for the deck's
+#                    coul_near (near + skin, the deck copied with a comm_modify cutoff line; the
+#                    same as neutral-plane while near + skin is within the pair's cutoff)
 #   charged          q 400 (fix coul/fmm: plane injection, near list, evaluations)
 # and the ratio of each to the neutral step.
 #   bench/deposition/charged_gap.sh <build-dir> [seed] [variant ...]
@@ -14,9 +15,9 @@ deck=$(realpath "$here/../../python/granular_charged/decks/in.deposition")
 build=$(cd "$1" && pwd); seed=${2:-1}; shift $(( $# >= 2 ? 2 : 1 ))
 variants=("$@"); [ ${#variants[@]} -gt 0 ] || variants=(neutral neutral-plane neutral-ghost charged)
 out=$(mktemp -d)
-# the deck with the ghost cutoff of near 3 r_p (3.25 r_p: near + skin) and nothing else changed
-sed 's/^comm_modify     vel yes$/comm_modify     vel yes cutoff $(3.25*v_rp)/' "$deck" > "$out/in.ghost"
-grep -q 'cutoff \$(3.25\*v_rp)' "$out/in.ghost" || { echo "comm_modify line not found in $deck"; exit 1; }
+# the deck with the ghost cutoff of its near list (near + skin) and nothing else changed
+sed 's/^comm_modify     vel yes$/comm_modify     vel yes cutoff $(v_coul_near*v_rp+v_skin)/' "$deck" > "$out/in.ghost"
+grep -q 'cutoff \$(v_coul_near\*v_rp+v_skin)' "$out/in.ghost" || { echo "comm_modify line not found in $deck"; exit 1; }
 common=(-var N 500 -var L_rp 14 -var seed "$seed")
 base=""
 for v in "${variants[@]}"; do
