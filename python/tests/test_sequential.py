@@ -65,16 +65,20 @@ def test_plane_rain_start_plane_follows_the_resting_bed(cli, tmp_path):
     and drift upwards while touching. The start plane h = z_top + seq_dz_L L must follow the
     resting bed, not such a pair: when it followed them, the plane and the lid rose with the
     pair at N = 2000, L = 28 r_p until h left the box (at this size: h up to 25 r_p and three
-    particles still flying at the end). Asserted: nothing flies at the end, and no start
-    plane was more than seq_dz_L L = 7 r_p (+ 0.5 r_p for the bed's growth between the last
-    two starts) above the final bed top. Measured: 11.5 r_p against 4.7 + 7.5."""
+    particles still flying at the end). Asserted: all 40 inserted, and no start plane was more
+    than seq_dz_L L = 7 r_p (+ 0.5 r_p for the bed's growth between the last two starts) above
+    the final bed top. Measured: 11.5 r_p against 4.7 + 7.5. Not asserted: that nothing flies
+    at the end. On this sparse bed a particle that rebounds flies a ballistic arc of a few ms
+    (nothing damps it), and whether one is still in the air when the settling ends is the
+    seed's: seeds 1-30 of this command left one in 9 runs with coul_near 2 and in 6 with
+    coul_near 3."""
     rp = 2.0e-6
     res, log = _run(cli, tmp_path, 400, size=[
         "--N", 40, "--seed", 1, "--var", "L_rp", 28, "--var", "inject", "sequential",
         "--var", "seq_dz_L", 0.25, "--var", "seq_gap_rp", 4, "--no-render",
         # the loop's commands echoed (in log.inject.lammps): the start heights are read there
         "--var", "split_log", "yes", "--var", "log_file", "log.lammps"])
-    assert res["inserted"] == 40 and res["flying"] == 0
+    assert res["inserted"] == 40
     starts = [float(h) for h in re.findall(r"^\s*variable\s+h equal ([0-9.eE+-]+)\s*$", log, re.M)]
     assert len(starts) == 40
     # the last thermo block of the sequential section: its columns name c_ztop
