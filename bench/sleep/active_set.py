@@ -12,7 +12,7 @@ copy of the deck with them, every 500000 steps:
     lmp -in in.diag -var out OUT -var N 8000 -var L_rp 28 -var seed 1
     bench/sleep/active_set.py HALO_RP OUT/diag.*.dump
 
-HALO_RP: fix bury/gran's halo in r_p (the deck's: max(2 r_max, coul_near r_p) + 4 r_max + 3 skin,
+HALO_RP: fix bury/gran's halo in r_p (the deck's: max(2 r_max + skin, coul_near r_p) + 4 r_max + 2 skin,
 6.75 for one size of particle). The cells are those of fix bury/gran: 2 r_max wide in x and y,
 r_max / 2 tall, a window of ceil(halo / cell) cells each way.
 """
