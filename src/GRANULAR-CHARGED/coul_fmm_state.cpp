@@ -26,7 +26,7 @@ using MTS = CoulFMMTimeStepping;
 
 CoulFMMState::CoulFMMState(LAMMPS *lmp, int cols, int bit) :
     Pointers(lmp), field_cols(cols), groupbit(bit), applied(nullptr), applied_force(nullptr),
-    row(nullptr), mpi(lmp)
+    row(nullptr), mpi(lmp), positions_pending(false), hashes_local(0), hashes_nlocal(-1)
 {
 }
 
@@ -46,12 +46,14 @@ void CoulFMMState::grow(int nmax)
 
 void CoulFMMState::copy(int i, int j)
 {
+  forget_hashes();
   std::copy(applied[i], applied[i] + field_cols, applied[j]);
   std::copy(row[i], row[i] + MTS::COLS, row[j]);
 }
 
 void CoulFMMState::clear(int i)
 {
+  forget_hashes();
   std::fill(applied[i], applied[i] + field_cols, 0.0);
   std::fill(row[i], row[i] + MTS::COLS, 0.0);
 }
@@ -65,6 +67,7 @@ int CoulFMMState::pack_exchange(int i, double *buf) const
 
 int CoulFMMState::unpack_exchange(int i, const double *buf)
 {
+  forget_hashes();
   std::copy(buf, buf + field_cols, applied[i]);
   std::copy(buf + field_cols, buf + field_cols + MTS::COLS, row[i]);
   return exchange_size();
@@ -76,12 +79,14 @@ int CoulFMMState::pack_restart(int i, double *buf) const
   buf[0] = restart_size();
   std::copy(applied[i], applied[i] + 4, buf + 1);
   std::copy(row[i], row[i] + MTS::COLS, buf + 5);
+  if (positions_pending) domain->unmap(atom->x[i], atom->image[i], buf + 5 + MTS::LAST_X);
   return restart_size();
 }
 
 // files written before the ASLEEP column hold COLS_V1 columns: the rest start at zero
 void CoulFMMState::unpack_restart(int i, const double *values)
 {
+  forget_hashes();
   const int cols = std::min<int>(MTS::COLS, std::max<int>(MTS::COLS_V1, static_cast<int>(values[0]) - 5));
   int m = 1;
   for (int k = 0; k < 4; k++) applied[i][k] = values[m++];
@@ -99,12 +104,23 @@ void CoulFMMState::apply_evaluated(int i)
   for (int k = 0; k < 4; k++) applied[i][k] = row[i][MTS::FIELD + k];
 }
 
-void CoulFMMState::remember_applied()
+void CoulFMMState::remember_charges()
 {
-  for (int i = 0; i < atom->nlocal; i++) {
-    domain->unmap(atom->x[i], atom->image[i], &row[i][MTS::LAST_X]);
+  for (int i = 0; i < atom->nlocal; i++)
     row[i][MTS::LAST_Q] = (atom->mask[i] & groupbit) ? atom->q[i] : 0.0;
-  }
+}
+
+void CoulFMMState::remember_positions(bool now)
+{
+  positions_pending = !now;
+  if (now)
+    for (int i = 0; i < atom->nlocal; i++)
+      domain->unmap(atom->x[i], atom->image[i], &row[i][MTS::LAST_X]);
+}
+
+void CoulFMMState::settle_positions()
+{
+  if (positions_pending) remember_positions(true);
 }
 
 void CoulFMMState::field_scale_sums(double sums[2])
@@ -142,12 +158,22 @@ void CoulFMMState::cell(double box[4]) const
   box[3] = domain->yprd;
 }
 
+uint64_t CoulFMMState::local_hashes()
+{
+  if (hashes_nlocal != atom->nlocal) {
+    hashes_local = 0;
+    for (int i = 0; i < atom->nlocal; i++)
+      if (charge_then(i) != 0.0) hashes_local += coul_fmm_charge_hash(atom->tag[i], charge_then(i));
+    hashes_nlocal = atom->nlocal;
+  }
+  return hashes_local;
+}
+
 void CoulFMMState::record(CoulFMMTimeStepping &scheme, int boundary)
 {
   auto &then = scheme.evaluated;
-  then.charges = 0;
-  for (int i = 0; i < atom->nlocal; i++)
-    if (charge_then(i) != 0.0) then.charges += coul_fmm_charge_hash(atom->tag[i], charge_then(i));
+  forget_hashes();    // the evaluation wrote the charges of its rows
+  then.charges = local_hashes();
   mpi.sum(&then.charges, 1);
   then.step = update->ntimestep;
   then.qqrd2e = force->qqrd2e;
@@ -178,7 +204,6 @@ CoulFMMTimeStepping::Continuity CoulFMMState::continuity(const CoulFMMTimeSteppi
     // a static source (then or now) is not absorbed: its field is the static field's
     const bool absorbed = absorb && q != q_then && q_then != 0.0 && q != 0.0 &&
         !static_source_then(i) && !asleep_now(i);
-    if (q_then != 0.0) sums[0] += coul_fmm_charge_hash(atom->tag[i], q_then);
     if (q != q_then && !absorbed) sums[1]++;
     if (q != q_then && q_then != 0.0 && !absorbed) sums[2]++;
     if (q != 0.0 && static_source_then(i) && !asleep_now(i)) sums[3]++;
@@ -191,6 +216,7 @@ CoulFMMTimeStepping::Continuity CoulFMMState::continuity(const CoulFMMTimeSteppi
       dq[1] += q - q_then;
     }
   }
+  sums[0] = local_hashes();
   mpi.sum(sums, 7);
   if (absorb) mpi.sum(dq, 2);
   changes.since_applied = (double) sums[4];

@@ -20,6 +20,7 @@
 #include "coul_fmm_time_stepping.h"
 #include "pointers.h"
 
+#include <cstdint>
 #include <functional>
 
 namespace LAMMPS_NS {
@@ -59,9 +60,14 @@ class CoulFMMState : protected Pointers {
   const double *position_applied(int i) const { return &row[i][MTS::LAST_X]; }
   // the evaluated field becomes the applied one (the atoms' first field columns)
   void apply_evaluated(int i);
-  // where the local atoms are and their charges when a field was applied: a later run continues
-  // the stored field only from those positions, and the next step counts the charges changed
-  void remember_applied();
+  // the local atoms' charges when a field was applied: the next step counts the charges changed
+  void remember_charges();
+  // where the local atoms are when a field was applied: a later run continues the stored field
+  // only from those positions. `now` false: the positions of the dynamics' last step, taken when
+  // they are needed (settle_positions at the end of the run, a restart file written meanwhile),
+  // as the atoms do not move between a step's forces and its end
+  void remember_positions(bool now);
+  void settle_positions();
   // before an evaluation: every charge of the group is finite, else an error naming the atom
   // (a NaN or inf charge would make every field and force NaN)
   void check_charges(const char *fix_id) const;
@@ -90,6 +96,8 @@ class CoulFMMState : protected Pointers {
   // since the field was last applied (displace_atoms, set)
   CoulFMMTimeStepping::Continuity continuation(const CoulFMMTimeStepping &scheme, int boundary,
                                                const Predicate &asleep_now);
+  // at the start of a run: the atoms' tags, groups or charges may have been changed in between
+  void forget_hashes() { hashes_nlocal = -1; }
 
  private:
   int field_cols;
@@ -97,7 +105,15 @@ class CoulFMMState : protected Pointers {
   double **applied, **applied_force, **row;
   CoulFMMComm mpi;
   ChargeChanges changes;
+  // positions of the last applied field still to be taken (remember_positions(false))
+  bool positions_pending;
+  // this rank's sum of coul_fmm_charge_hash over the evaluation's charges (continuity): it
+  // changes only with the atoms (created, deleted, migrated, sorted, read: the per-atom
+  // callbacks) or with an evaluation, so it is kept until one of those
+  uint64_t hashes_local;
+  int hashes_nlocal;    // -1: not known
   void cell(double box[4]) const;
+  uint64_t local_hashes();
 };
 
 }    // namespace LAMMPS_NS

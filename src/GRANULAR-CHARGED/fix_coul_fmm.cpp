@@ -283,8 +283,10 @@ void FixCoulFMM::init_list(int /*id*/, NeighList *ptr)
 
 void FixCoulFMM::setup(int vflag)
 {
+  // a new run: its atoms and state may have been changed in between (tags, groups, charges)
+  state->forget_hashes();
   if (!scheme->continues()) stepping->restart_schedule();
-  near->forget_pairs();    // a new run: its atoms and state may have been changed in between
+  near->forget_pairs();
   if (utils::strmatch(update->integrate_style, "^verlet")) {
     post_force(vflag);
   } else {
@@ -315,6 +317,7 @@ void FixCoulFMM::min_setup(int vflag)
 // any; counted from the end of the last run (a run with pre no has no setup)
 void FixCoulFMM::post_run()
 {
+  state->settle_positions();
   const auto &run = stepping->absorbed_this_run();
   if (run.changes > 0.0 && comm->me == 0)
     utils::logmesg(lmp,
@@ -358,7 +361,9 @@ void FixCoulFMM::apply(int vflag, bool predict)
                    in_plane ? fi[2] * x[i][1] : 0.0};
     v_tally(i, v);
   }
-  state->remember_applied();
+  state->remember_charges();
+  // a minimizer may go back to other positions after its last force evaluation
+  state->remember_positions(!predict);
 }
 
 // with static sleepers, plus their pair energy with the awake charges and among themselves

@@ -969,6 +969,31 @@ TEST(CoulFMM, ToleranceScheduleIndependentOfRunSplit)
   EXPECT_LT(rel_rms(restarted, straight), 1e-10);
 }
 
+// a restart file written within a run (the restart command, here at step 30) continues the schedule as one
+// written between runs: the positions at which the field was last applied, which a continued
+// run checks its atoms against, are those of the step the file is written on (tolerance as
+// above: the near pairs are summed in another order after the restart). Started afresh, the
+// continued run would evaluate at once and adapt its interval again from 1.
+TEST(CoulFMM, RestartWrittenWithinARunContinuesTheSchedule)
+{
+  const std::string fix = "fix fmm all coul/fmm accuracy 1e-6 every 32 near 6.0 tolerance 1e-4";
+  std::vector<double> straight, restarted;
+  {
+    Lmp l;
+    moving_charges(l);
+    l.cmds({fix, "restart 30 coul_fmm_within.restart", "run 40 post no", "run 0 post no"});
+    straight = gather(l, "x", 3);
+  }
+  {
+    Lmp l;
+    l.cmds({"read_restart coul_fmm_within.restart.30", "fix nve all nve", fix, "run 10 post no",
+            "run 0 post no"});
+    restarted = gather(l, "x", 3);
+  }
+  std::remove("coul_fmm_within.restart.30");
+  EXPECT_LT(rel_rms(restarted, straight), 1e-10);
+}
+
 // charges created between two runs (the deposition deck's one-by-one insertion) are a known
 // change: the next run's first step evaluates them with the others, as fix deposit's insertion
 // within a run is, and the adapted interval and the other atoms' slopes go on. Started again,
