@@ -1,12 +1,15 @@
 // P2P kernel of gcfmm against a plain long-double double loop, and the direct sums.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <random>
 #include <vector>
 
 #include "gcfmm/expansions.hpp"
 #include "gcfmm/kernels.hpp"
+#include "gcfmm/options.hpp"
 #include "fmm_test_util.hpp"
 
 using namespace gcfmm;
@@ -181,4 +184,73 @@ TEST(P2P, EverySimdPathMatchesGeneric) {
             << gcsimd::simd_path_name(path) << " l2p p=" << p << " target " << i;
     }
   }
+}
+
+// The kernels of p2p_kernel_within(): one pair at a time (one source, 64 targets at distances
+// log-uniform over 44 decades, beyond the single-precision estimate's range at both ends too),
+// each term against long double. A reduced kernel stays within its stated term error (the
+// potential within a third of it) and comes near it (the test would pass vacuously on a
+// full-precision kernel otherwise); the full-precision one is round-off and is p2p_with().
+TEST(P2P, KernelsWithinTheirTermError) {
+  std::mt19937 g(17);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const std::size_t nt = 64, trials = 400;
+  for (gcsimd::SimdPath path : {gcsimd::SimdPath::Generic, gcsimd::SimdPath::AVX2, gcsimd::SimdPath::AVX512}) {
+    if (!gcsimd::simd_path_available(path)) {
+      std::printf("[ skipped  ] path %s not available on this CPU\n", gcsimd::simd_path_name(path));
+      continue;
+    }
+    for (double tolerance : {0.0, 1e-12, 1e-7, 1e-6}) {
+      const P2PKernel k = p2p_kernel_within(tolerance, path);
+      EXPECT_LE(k.term_error, tolerance) << gcsimd::simd_path_name(path);
+      double worst_pot = 0.0, worst_field = 0.0;
+      for (std::size_t trial = 0; trial < trials; ++trial) {
+        std::vector<double> x(nt), y(nt), z(nt), pot(nt, 0.0), ex(nt, 0.0), ey(nt, 0.0), ez(nt, 0.0);
+        for (std::size_t i = 0; i < nt; ++i) {
+          const double r = std::pow(10.0, -22.0 + 44.0 * u(g)), ct = 2.0 * u(g) - 1.0, ph = 6.283185307179586 * u(g);
+          const double st = std::sqrt(1.0 - ct * ct);
+          x[i] = r * st * std::cos(ph);
+          y[i] = r * st * std::sin(ph);
+          z[i] = r * ct;
+        }
+        const double xs = 0.0, ys = 0.0, zs = 0.0, qs = 1.0;
+        k.run(nt, x.data(), y.data(), z.data(), 1, &xs, &ys, &zs, &qs, 0.0, 0.0, 0.0, pot.data(), ex.data(),
+              ey.data(), ez.data(), 0.0);
+        for (std::size_t i = 0; i < nt; ++i) {
+          const long double dx = x[i], dy = y[i], dz = z[i], r2 = dx * dx + dy * dy + dz * dz, r = std::sqrt(r2);
+          const long double p = 1.0L / r, e = 1.0L / r2;    // |E| = 1 / r^2
+          worst_pot = std::max(worst_pot, (double)(std::fabs(pot[i] - p) / p));
+          const long double fx = ex[i] - dx / (r * r2), fy = ey[i] - dy / (r * r2), fz = ez[i] - dz / (r * r2);
+          worst_field = std::max(worst_field, (double)(std::sqrt(fx * fx + fy * fy + fz * fz) / e));
+        }
+      }
+      // round-off of a few operations on top of the stated error
+      const double roundoff = 1e-15;
+      EXPECT_LE(worst_pot, k.term_error / 3.0 + roundoff) << gcsimd::simd_path_name(path) << " tol " << tolerance;
+      EXPECT_LE(worst_field, k.term_error + roundoff) << gcsimd::simd_path_name(path) << " tol " << tolerance;
+      if (k.term_error > 0.0) EXPECT_GT(worst_field, 0.05 * k.term_error) << gcsimd::simd_path_name(path);
+      std::printf("[ kernel   ] %s within %g: term error %g, measured %.3g (field) %.3g (potential)\n",
+                  gcsimd::simd_path_name(path), tolerance, k.term_error, worst_field, worst_pot);
+    }
+    // the full-precision kernel is the one of p2p_with()
+    auto src = gcfmm_test::random_cube(101, 41);
+    auto tgt = gcfmm_test::random_cube(37, 42, 1.5);
+    gcfmm_test::Field a(tgt.size()), b(tgt.size());
+    p2p_with(path, tgt.size(), tgt.x.data(), tgt.y.data(), tgt.z.data(), src.size(), src.x.data(), src.y.data(),
+             src.z.data(), src.q.data(), 0.1, -0.2, 0.3, a.pot.data(), a.ex.data(), a.ey.data(), a.ez.data());
+    p2p_kernel_within(0.0, path)
+        .run(tgt.size(), tgt.x.data(), tgt.y.data(), tgt.z.data(), src.size(), src.x.data(), src.y.data(),
+             src.z.data(), src.q.data(), 0.1, -0.2, 0.3, b.pot.data(), b.ex.data(), b.ey.data(), b.ez.data(), 0.0);
+    for (std::size_t i = 0; i < tgt.size(); ++i) {
+      EXPECT_EQ(a.pot[i], b.pot[i]);
+      EXPECT_EQ(a.ez[i], b.ez[i]);
+    }
+  }
+  // the solver's share: kP2PTermShare of the accuracy when accuracy chooses the order, full
+  // precision with an explicit order
+  Options o;
+  o.accuracy = 1e-4;
+  EXPECT_DOUBLE_EQ(p2p_term_tolerance(o), kP2PTermShare * 1e-4);
+  o.order = 6;
+  EXPECT_EQ(p2p_term_tolerance(o), 0.0);
 }

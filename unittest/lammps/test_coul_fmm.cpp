@@ -699,6 +699,16 @@ void moving_charges(Lmp &l, const std::string &boundary = "p p m")
   l.cmds({"mass 1 1000.0", "velocity all create 300 5 loop geom", "fix nve all nve",
           "timestep 1.0"});
 }
+
+// the positions after a new instance reads `file`, defines `fix` and runs `steps` more (a final
+// run 0 wraps them as in the uninterrupted run)
+std::vector<double> continued_from(const std::string &file, const std::string &fix, int steps)
+{
+  Lmp l;
+  l.cmds({"read_restart " + file, "fix nve all nve", fix, fmt::format("run {} post no", steps),
+          "run 0 post no"});
+  return gather(l, "x", 3);
+}
 }    // namespace
 
 // evaluations fall on multiples of every, whatever the run lengths: a run split at a step
@@ -958,22 +968,17 @@ TEST(CoulFMM, ToleranceScheduleIndependentOfRunSplit)
     split = gather(l, "x", 3);
     EXPECT_EQ(l.var("f_fmm[10]"), evaluations);
   }
-  {
-    Lmp l;
-    l.cmds({"read_restart coul_fmm_tol.restart", "fix nve all nve", fix, "run 10 post no",
-            "run 0 post no"});
-    restarted = gather(l, "x", 3);
-  }
+  restarted = continued_from("coul_fmm_tol.restart", fix, 10);
   std::remove("coul_fmm_tol.restart");
   EXPECT_LT(rel_rms(split, straight), 1e-14);
   EXPECT_LT(rel_rms(restarted, straight), 1e-10);
 }
 
-// a restart file written within a run (the restart command, here at step 30) continues the schedule as one
-// written between runs: the positions at which the field was last applied, which a continued
-// run checks its atoms against, are those of the step the file is written on (tolerance as
-// above: the near pairs are summed in another order after the restart). Started afresh, the
-// continued run would evaluate at once and adapt its interval again from 1.
+// a restart file written within a run (the restart command, here at step 30) continues the
+// schedule as one written between runs: the positions at which the field was last applied,
+// which a continued run checks its atoms against, are those of the step the file is written on
+// (tolerance as above: the near pairs are summed in another order after the restart). Started
+// afresh, the continued run would evaluate at once and adapt its interval again from 1.
 TEST(CoulFMM, RestartWrittenWithinARunContinuesTheSchedule)
 {
   const std::string fix = "fix fmm all coul/fmm accuracy 1e-6 every 32 near 6.0 tolerance 1e-4";
@@ -984,12 +989,7 @@ TEST(CoulFMM, RestartWrittenWithinARunContinuesTheSchedule)
     l.cmds({fix, "restart 30 coul_fmm_within.restart", "run 40 post no", "run 0 post no"});
     straight = gather(l, "x", 3);
   }
-  {
-    Lmp l;
-    l.cmds({"read_restart coul_fmm_within.restart.30", "fix nve all nve", fix, "run 10 post no",
-            "run 0 post no"});
-    restarted = gather(l, "x", 3);
-  }
+  restarted = continued_from("coul_fmm_within.restart.30", fix, 10);
   std::remove("coul_fmm_within.restart.30");
   EXPECT_LT(rel_rms(restarted, straight), 1e-10);
 }

@@ -147,7 +147,7 @@ void DistributedSolver::Impl::remote_p2p_m2p() {
   stats.m2p_count = 0;
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const Node &A = nodes[i];
-    p2p_entries(remote, i, A.begin, A.end, xs, ys, zs, let.tree.nodes, let.tree.xs.data(), let.tree.ys.data(),
+    p2p_entries(c.p2p_kernel, remote, i, A.begin, A.end, xs, ys, zs, let.tree.nodes, let.tree.xs.data(), let.tree.ys.data(),
                 let.tree.zs.data(), let.q.data(), pot, ex, ey, ez);
     for (std::uint32_t e = remote.m2p_offset[i]; e < remote.m2p_offset[i + 1]; ++e) {
       const Interaction &it = remote.m2p[e];

@@ -71,7 +71,7 @@ using p2p_loop_fn = void(*) GCFMM_P2P_PARAMS;
 // so no such call exists
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
-template <class Reg>
+template <class Reg, int Steps>
 inline void p2p_rsqrt(std::size_t nt, const double *__restrict xt, const double *__restrict yt,
                       const double *__restrict zt, std::size_t ns, const double *__restrict xs,
                       const double *__restrict ys, const double *__restrict zs, const double *__restrict qs,
@@ -90,7 +90,7 @@ inline void p2p_rsqrt(std::size_t nt, const double *__restrict xt, const double 
       const V dy = Reg::sub(yi, Reg::set1(ys[j]));
       const V dz = Reg::sub(zi, Reg::set1(zs[j]));
       const V r2 = Reg::fmadd(dx, dx, Reg::fmadd(dy, dy, Reg::mul(dz, dz)));
-      const V y = Reg::rsqrt(r2, rmin2);    // 0 for the self term and coincident pairs
+      const V y = Reg::template rsqrt<Steps>(r2, rmin2);    // 0 for the self term and coincident pairs
       const V qi = Reg::mul(Reg::set1(qs[j]), y);
       const V qi3 = Reg::mul(qi, Reg::mul(y, y));
       p = Reg::add(p, qi);
@@ -109,11 +109,12 @@ inline void p2p_rsqrt(std::size_t nt, const double *__restrict xt, const double 
 #define GCFMM_NEWTON(fnmadd, mul, y, hr2, three_half) y = mul(y, fnmadd(hr2, mul(y, y), three_half))
 
 // AVX-512, 8 targets: the 14-bit estimate (vrsqrt14pd, zero where the pair is dropped) and two
-// Newton steps (2^-14 -> 2^-28 -> ~1e-16)
+// Newton steps (2^-14 -> 2^-28 -> ~1e-16), or one where the accuracy allows (p2p_kernel_within)
 struct Avx512 {
   using V = __m512d;
   using Mask = __mmask8;
   static constexpr std::size_t kWidth = 8;
+  static constexpr int kFullSteps = 2;    // Newton steps to round-off
   GCSIMD_TARGET_AVX512 static Mask tail(std::size_t left) {
     return left >= 8 ? static_cast<__mmask8>(0xFF) : static_cast<__mmask8>((1u << left) - 1u);
   }
@@ -126,25 +127,29 @@ struct Avx512 {
   GCSIMD_TARGET_AVX512 static V sub(V a, V b) { return _mm512_sub_pd(a, b); }
   GCSIMD_TARGET_AVX512 static V mul(V a, V b) { return _mm512_mul_pd(a, b); }
   GCSIMD_TARGET_AVX512 static V fmadd(V a, V b, V c) { return _mm512_fmadd_pd(a, b, c); }
+  template <int Steps>
   GCSIMD_TARGET_AVX512 static V rsqrt(V r2, V rmin2) {
+    static_assert(Steps == 1 || Steps == 2, "AVX-512 P2P: 1 or 2 Newton steps");
     const __m512d half = _mm512_set1_pd(0.5), three_half = _mm512_set1_pd(1.5);
     const __mmask8 keep = _mm512_cmp_pd_mask(r2, rmin2, _CMP_GT_OQ);
     __m512d y = _mm512_maskz_rsqrt14_pd(keep, r2);
     const __m512d hr2 = _mm512_mul_pd(half, r2);
     GCFMM_NEWTON(_mm512_fnmadd_pd, _mm512_mul_pd, y, hr2, three_half);
-    GCFMM_NEWTON(_mm512_fnmadd_pd, _mm512_mul_pd, y, hr2, three_half);
+    if constexpr (Steps == 2) GCFMM_NEWTON(_mm512_fnmadd_pd, _mm512_mul_pd, y, hr2, three_half);
     return y;
   }
 };
 
 // AVX2, 4 targets: the single-precision estimate (vrsqrtps, relative error <= 1.5 2^-12) and
-// three Newton steps (2^-12 -> 2^-23 -> 2^-45 -> round-off). Lanes whose r2 is outside the
+// three Newton steps (2^-12 -> 2^-23 -> 2^-45 -> round-off), or fewer where the accuracy allows
+// (p2p_kernel_within). Lanes whose r2 is outside the
 // normal single-precision range (below 1e-36 or above 1e36, where the estimate does not exist)
 // take the exact 1/sqrt instead.
 struct Avx2 {
   using V = __m256d;
   using Mask = __m256i;
   static constexpr std::size_t kWidth = 4;
+  static constexpr int kFullSteps = 3;    // Newton steps to round-off
   GCSIMD_TARGET_AVX2 static Mask tail(std::size_t left) {
     const long long all = -1;
     return _mm256_set_epi64x(left > 3 ? all : 0, left > 2 ? all : 0, left > 1 ? all : 0, all);
@@ -158,15 +163,17 @@ struct Avx2 {
   GCSIMD_TARGET_AVX2 static V sub(V a, V b) { return _mm256_sub_pd(a, b); }
   GCSIMD_TARGET_AVX2 static V mul(V a, V b) { return _mm256_mul_pd(a, b); }
   GCSIMD_TARGET_AVX2 static V fmadd(V a, V b, V c) { return _mm256_fmadd_pd(a, b, c); }
+  template <int Steps>
   GCSIMD_TARGET_AVX2 static V rsqrt(V r2, V rmin2) {
+    static_assert(Steps >= 1 && Steps <= 3, "AVX2 P2P: 1 to 3 Newton steps");
     const __m256d half = _mm256_set1_pd(0.5), three_half = _mm256_set1_pd(1.5);
     const __m256d lo = _mm256_set1_pd(1e-36), hi = _mm256_set1_pd(1e36), one = _mm256_set1_pd(1.0);
     const __m256d keep = _mm256_cmp_pd(r2, rmin2, _CMP_GT_OQ);
     __m256d y = _mm256_cvtps_pd(_mm_rsqrt_ps(_mm256_cvtpd_ps(r2)));
     const __m256d hr2 = _mm256_mul_pd(half, r2);
     GCFMM_NEWTON(_mm256_fnmadd_pd, _mm256_mul_pd, y, hr2, three_half);
-    GCFMM_NEWTON(_mm256_fnmadd_pd, _mm256_mul_pd, y, hr2, three_half);
-    GCFMM_NEWTON(_mm256_fnmadd_pd, _mm256_mul_pd, y, hr2, three_half);
+    if constexpr (Steps >= 2) GCFMM_NEWTON(_mm256_fnmadd_pd, _mm256_mul_pd, y, hr2, three_half);
+    if constexpr (Steps >= 3) GCFMM_NEWTON(_mm256_fnmadd_pd, _mm256_mul_pd, y, hr2, three_half);
     const __m256d out = _mm256_or_pd(_mm256_cmp_pd(r2, lo, _CMP_LT_OQ), _mm256_cmp_pd(r2, hi, _CMP_GT_OQ));
     if (_mm256_movemask_pd(_mm256_and_pd(out, keep))) y = _mm256_blendv_pd(y, _mm256_div_pd(one, _mm256_sqrt_pd(r2)), out);
     return _mm256_and_pd(y, keep);
@@ -175,10 +182,19 @@ struct Avx2 {
 #undef GCFMM_NEWTON
 
 __attribute__((flatten)) GCSIMD_TARGET_AVX512 void p2p_rsqrt_avx512 GCFMM_P2P_PARAMS {
-  p2p_rsqrt<Avx512> GCFMM_P2P_ARGS;
+  p2p_rsqrt<Avx512, Avx512::kFullSteps> GCFMM_P2P_ARGS;
+}
+__attribute__((flatten)) GCSIMD_TARGET_AVX512 void p2p_rsqrt_avx512_newton1 GCFMM_P2P_PARAMS {
+  p2p_rsqrt<Avx512, 1> GCFMM_P2P_ARGS;
 }
 __attribute__((flatten)) GCSIMD_TARGET_AVX2 void p2p_rsqrt_avx2 GCFMM_P2P_PARAMS {
-  p2p_rsqrt<Avx2> GCFMM_P2P_ARGS;
+  p2p_rsqrt<Avx2, Avx2::kFullSteps> GCFMM_P2P_ARGS;
+}
+__attribute__((flatten)) GCSIMD_TARGET_AVX2 void p2p_rsqrt_avx2_newton2 GCFMM_P2P_PARAMS {
+  p2p_rsqrt<Avx2, 2> GCFMM_P2P_ARGS;
+}
+__attribute__((flatten)) GCSIMD_TARGET_AVX2 void p2p_rsqrt_avx2_newton1 GCFMM_P2P_PARAMS {
+  p2p_rsqrt<Avx2, 1> GCFMM_P2P_ARGS;
 }
 #pragma GCC diagnostic pop
 #endif
@@ -196,7 +212,32 @@ p2p_loop_fn p2p_kernel(gcsimd::SimdPath path) {
   return p2p_loop_generic;
 }
 
+// The largest relative error of one pair's field term of the reduced kernels (its potential
+// term has a third of it). One Newton step from an estimate of relative error e leaves
+// 1.5 e^2 + e^3 / 2, and the field term carries y^3, three times the error of y. vrsqrt14pd:
+// e <= 2^-14, so 5.6e-9 after one step (1.7e-8 in the field term); vrsqrtps: e <= 1.5 2^-12
+// (with 2^-25 from rounding r2 to single precision), so 2.0e-7 after one step (6.0e-7) and
+// 6.1e-14 after two (1.8e-13). Rounded up; test_p2p measures them.
+constexpr double kAvx512Newton1TermError = 2e-8;
+constexpr double kAvx2Newton1TermError = 7e-7;
+constexpr double kAvx2Newton2TermError = 2e-13;
+
 }  // namespace
+
+P2PKernel p2p_kernel_within(double max_term_error, gcsimd::SimdPath path) {
+  if (!gcsimd::simd_path_available(path))
+    throw std::invalid_argument(std::string("gcfmm: SIMD path ") + gcsimd::simd_path_name(path) + " not available");
+#if GCSIMD_X86_DISPATCH
+  if (path == gcsimd::SimdPath::AVX512)
+    return max_term_error >= kAvx512Newton1TermError ? P2PKernel{p2p_rsqrt_avx512_newton1, kAvx512Newton1TermError}
+                                                     : P2PKernel{p2p_rsqrt_avx512, 0.0};
+  if (path == gcsimd::SimdPath::AVX2) {
+    if (max_term_error >= kAvx2Newton1TermError) return {p2p_rsqrt_avx2_newton1, kAvx2Newton1TermError};
+    if (max_term_error >= kAvx2Newton2TermError) return {p2p_rsqrt_avx2_newton2, kAvx2Newton2TermError};
+  }
+#endif
+  return {p2p_kernel(path), 0.0};
+}
 
 void p2p_with(gcsimd::SimdPath path, std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
               const double *xs, const double *ys, const double *zs, const double *qs, double sx, double sy, double sz,
@@ -307,7 +348,7 @@ inline void p2p_dipoles_rsqrt GCFMM_P2PD_PARAMS {
     FieldTerms<V> f;
     for (std::size_t j = 0; j < ns; ++j) {
       const V dx = xi - Reg::set1(xs[j]), dy = yi - Reg::set1(ys[j]), dz = zi - Reg::set1(zs[j]);
-      const V rinv = Reg::rsqrt(dx * dx + dy * dy + dz * dz, rmin2);
+      const V rinv = Reg::template rsqrt<Reg::kFullSteps>(dx * dx + dy * dy + dz * dz, rmin2);
       if (kCharges) charge_terms<kGradient>(Reg::set1(qs[j]), dx, dy, dz, rinv, f);
       if (kDipoles) dipole_terms<kGradient>(Reg::set1(pxs[j]), Reg::set1(pys[j]), Reg::set1(pzs[j]), dx, dy, dz, rinv, f);
     }

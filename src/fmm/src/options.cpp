@@ -95,6 +95,8 @@ double induction_tolerance(const Options &o) {
   return o.induction_tolerance > 0.0 ? o.induction_tolerance : 0.1 * o.accuracy;
 }
 
+double p2p_term_tolerance(const Options &o) { return o.order > 0 ? 0.0 : kP2PTermShare * o.accuracy; }
+
 ReachableAccuracy reachable_accuracy(const Options &o, const AccuracyParts &parts) {
   ReachableAccuracy r;
   if (o.order > 0) return r;

@@ -16,6 +16,7 @@ void SolverCore::configure(const Options &o) {
   opts.theta = res.theta;
   opts.leaf = res.leaf;
   ops.reset(new Operators(res.order));
+  p2p_kernel = p2p_kernel_within(p2p_term_tolerance(o), ops->simd_path());
   stats.order = res.order;
   stats.theta = res.theta;
   stats.leaf = res.leaf;

@@ -51,7 +51,7 @@ void SolverCore::m2l(const TargetRange &t) {
 void SolverCore::p2p(const TargetRange &t) {
   const auto &xs = tree.xs, &ys = tree.ys, &zs = tree.zs;
   for_target_nodes(t, [&](std::size_t i, const Node &A) {
-    p2p_entries(lists, i, t.first(A), t.last(A), xs.data(), ys.data(), zs.data(), tree.nodes, xs.data(), ys.data(),
+    p2p_entries(p2p_kernel, lists, i, t.first(A), t.last(A), xs.data(), ys.data(), zs.data(), tree.nodes, xs.data(), ys.data(),
                 zs.data(), sorted_q.data(), sorted_pot.data(), sorted_ex.data(), sorted_ey.data(), sorted_ez.data());
   });
 }

@@ -198,16 +198,17 @@ inline void m2l_entries(Operators &ops, const Node &A, const InteractionLists &l
 
 // P2P (eq. (3.1)) of the list entries of target node i at its targets [a, b) (tree order of the
 // target arrays tx, ty, tz; results added to pot, ex, ey, ez at the same indices), the sources
-// being the node ranges of `snodes` in the arrays sx, sy, sz, sq.
-inline void p2p_entries(const InteractionLists &lists, std::size_t i, std::size_t a, std::size_t b, const double *tx,
-                        const double *ty, const double *tz, const std::vector<Node> &snodes, const double *sx,
-                        const double *sy, const double *sz, const double *sq, double *pot, double *ex, double *ey,
-                        double *ez) {
+// being the node ranges of `snodes` in the arrays sx, sy, sz, sq; with the solver's kernel
+// (p2p_kernel_within its options' p2p_term_tolerance).
+inline void p2p_entries(const P2PKernel &kernel, const InteractionLists &lists, std::size_t i, std::size_t a,
+                        std::size_t b, const double *tx, const double *ty, const double *tz,
+                        const std::vector<Node> &snodes, const double *sx, const double *sy, const double *sz,
+                        const double *sq, double *pot, double *ex, double *ey, double *ez) {
   for (std::uint32_t e = lists.p2p_offset[i]; e < lists.p2p_offset[i + 1]; ++e) {
     const Interaction &it = lists.p2p[e];
     const Node &B = snodes[it.source];
     const Vec3 &sh = lists.shifts[it.shift];
-    gcfmm::p2p(b - a, tx + a, ty + a, tz + a, B.count(), sx + B.begin, sy + B.begin, sz + B.begin, sq + B.begin, sh.x,
+    kernel.run(b - a, tx + a, ty + a, tz + a, B.count(), sx + B.begin, sy + B.begin, sz + B.begin, sq + B.begin, sh.x,
                sh.y, sh.z, pot + a, ex + a, ey + a, ez + a, kCoincidenceRadius * kCoincidenceRadius);
   }
 }
@@ -226,6 +227,7 @@ struct SolverCore {
   Tree tree;
   InteractionLists lists;
   std::unique_ptr<Operators> ops;
+  P2PKernel p2p_kernel;                       // on the path of ops, within p2p_term_tolerance(opts)
   double h = 1.0, inv_h = 1.0;                // length unit (power of two) and its inverse
   double sx0 = 0.0, sy0 = 0.0, slx = 0.0, sly = 0.0;  // the cell in units of h
   std::vector<double> scaled_x, scaled_y, scaled_z;   // wrapped positions / h (original order)

@@ -28,6 +28,7 @@ struct StaticSourceField::Impl {
   bool sources_set = false;
   std::size_t ns = 0;                                  // sources given (with zero charges)
   std::unique_ptr<Operators> ops;
+  P2PKernel p2p_kernel;    // on the path of ops, within p2p_term_tolerance of the options
   double h = 1.0, inv_h = 1.0;                         // length unit and its inverse
   double sx0 = 0.0, sy0 = 0.0, slx = 0.0, sly = 0.0;   // the cell in units of h
   std::vector<Vec3> shifts;                            // image shifts of the sources (units of h)
@@ -86,6 +87,7 @@ StaticSourceField::StaticSourceField(const Options &opts) : impl_(new Impl) {
   I.opts.theta = I.res.theta;
   I.opts.leaf = I.res.leaf;
   I.ops.reset(new Operators(I.res.order));
+  I.p2p_kernel = p2p_kernel_within(p2p_term_tolerance(opts), I.ops->simd_path());
   I.stats.order = I.res.order;
   I.stats.theta = I.res.theta;
   I.stats.leaf = I.res.leaf;
@@ -353,7 +355,7 @@ void StaticSourceField::Impl::p2p() {
   const auto &tn = ttree.nodes, &sn = stree.nodes;
   const auto &xs = ttree.xs, &ys = ttree.ys, &zs = ttree.zs;
   for (std::size_t i = 0; i < tn.size(); ++i)
-    p2p_entries(lists, i, tn[i].begin, tn[i].end, xs.data(), ys.data(), zs.data(), sn, stree.xs.data(),
+    p2p_entries(p2p_kernel, lists, i, tn[i].begin, tn[i].end, xs.data(), ys.data(), zs.data(), sn, stree.xs.data(),
                 stree.ys.data(), stree.zs.data(), sq.data(), tpot.data(), tex.data(), tey.data(), tez.data());
 }
 

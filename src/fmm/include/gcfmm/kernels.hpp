@@ -27,6 +27,23 @@ void p2p_with(gcsimd::SimdPath path, std::size_t nt, const double *xt, const dou
               const double *xs, const double *ys, const double *zs, const double *qs, double sx, double sy, double sz,
               double *pot, double *ex, double *ey, double *ez, double r2_min = 0.0);
 
+//! A P2P kernel with the arguments of p2p(), and the largest relative error it makes in one
+//! pair's field term (its potential term has a third of it; 0: round-off only).
+struct P2PKernel {
+  using Function = void (*)(std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
+                            const double *xs, const double *ys, const double *zs, const double *qs, double sx,
+                            double sy, double sz, double *pot, double *ex, double *ey, double *ez, double r2_min);
+  Function run = nullptr;
+  double term_error = 0.0;
+};
+
+/** @brief The fastest P2P kernel of a path whose term error is at most max_term_error: on
+ *  AVX-512 and AVX2 fewer Newton steps after the hardware estimate of 1/sqrt(r2); 0 (or a
+ *  bound finer than the reduced kernels reach) gives the full-precision kernel of p2p_with().
+ *  The solver asks for p2p_term_tolerance() of its options (options.hpp).
+ *  @throws std::invalid_argument if the path is not available. */
+P2PKernel p2p_kernel_within(double max_term_error, gcsimd::SimdPath path = gcsimd::default_simd_path());
+
 /** @brief P2P of charges and point dipoles (doc/polarization.md, eq. (1.1)-(1.2)): add the
  *  potential, field and, if g6 is not null, the field gradient (6 per target: xx, xy, xz, yy,
  *  yz, zz) of sources (xs, ys, zs) with charges qs and dipoles (pxs, pys, pzs), shifted by

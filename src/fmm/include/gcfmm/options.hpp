@@ -81,6 +81,18 @@ Options static_part_options(const Options &opts);
  *  accuracy when it is 0 (doc/polarization.md, section 6). */
 double induction_tolerance(const Options &opts);
 
+//! The share of Options::accuracy that one pair's term of the P2P may carry (p2p_term_tolerance()).
+constexpr double kP2PTermShare = 1e-2;
+
+/** @brief The relative error one pair's field term of the P2P may carry (p2p_kernel_within(),
+ *  kernels.hpp): kP2PTermShare x accuracy when the order is chosen from accuracy; 0 (full
+ *  precision) with an explicit order, which accuracy does not govern. The error of a pair's
+ *  term has one sign (the Newton steps approach 1/sqrt(r2) from below), so a target's P2P error
+ *  is at most that share of the sum of its terms' magnitudes: 1e-3 leaves the request to the
+ *  expansions even where those terms cancel to a thousandth (doc/fmm-accuracy.md, "P2P
+ *  precision"). */
+double p2p_term_tolerance(const Options &opts);
+
 //! What sets the finest accuracy some options reach (reachable_accuracy()).
 enum class AccuracyLimit {
   None,           //!< an explicit order: accuracy does not choose it, every request is taken
