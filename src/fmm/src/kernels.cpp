@@ -142,9 +142,8 @@ struct Avx512 {
 
 // AVX2, 4 targets: the single-precision estimate (vrsqrtps, relative error <= 1.5 2^-12) and
 // three Newton steps (2^-12 -> 2^-23 -> 2^-45 -> round-off), or fewer where the accuracy allows
-// (p2p_kernel_within). Lanes whose r2 is outside the
-// normal single-precision range (below 1e-36 or above 1e36, where the estimate does not exist)
-// take the exact 1/sqrt instead.
+// (p2p_kernel_within). Lanes whose r2 is outside the normal single-precision range (below
+// 1e-36 or above 1e36, where the estimate does not exist) take the exact 1/sqrt instead.
 struct Avx2 {
   using V = __m256d;
   using Mask = __m256i;

@@ -86,11 +86,11 @@ constexpr double kP2PTermShare = 1e-2;
 
 /** @brief The relative error one pair's field term of the P2P may carry (p2p_kernel_within(),
  *  kernels.hpp): kP2PTermShare x accuracy when the order is chosen from accuracy; 0 (full
- *  precision) with an explicit order, which accuracy does not govern. The error of a pair's
- *  term has one sign (the Newton steps approach 1/sqrt(r2) from below), so a target's P2P error
- *  is at most that share of the sum of its terms' magnitudes: 1e-3 leaves the request to the
- *  expansions even where those terms cancel to a thousandth (doc/fmm-accuracy.md, "P2P
- *  precision"). */
+ *  precision) with an explicit order, which accuracy does not govern. A target's P2P error is
+ *  then at most that share of the sum of its terms' magnitudes, the unsigned scale the request
+ *  is measured against where fields cancel; the terms all err the same way (the Newton steps
+ *  approach 1/sqrt(r2) from below), so the errors do not average out and that bound is the one
+ *  to count on (doc/fmm-accuracy.md, "P2P precision"). */
 double p2p_term_tolerance(const Options &opts);
 
 //! What sets the finest accuracy some options reach (reachable_accuracy()).
