@@ -96,7 +96,8 @@ class CoulFMMState : protected Pointers {
   // since the field was last applied (displace_atoms, set)
   CoulFMMTimeStepping::Continuity continuation(const CoulFMMTimeStepping &scheme, int boundary,
                                                const Predicate &asleep_now);
-  // at the start of a run: the atoms' tags, groups or charges may have been changed in between
+  // the checksum of the evaluation's charges is taken afresh at its next use: the atoms changed,
+  // or a run starts (their tags may have been changed in between)
   void forget_hashes() { hashes_nlocal = -1; }
 
  private:

@@ -283,7 +283,7 @@ void FixCoulFMM::init_list(int /*id*/, NeighList *ptr)
 
 void FixCoulFMM::setup(int vflag)
 {
-  // a new run: its atoms and state may have been changed in between (tags, groups, charges)
+  // a new run: its atoms and state may have been changed in between
   state->forget_hashes();
   if (!scheme->continues()) stepping->restart_schedule();
   near->forget_pairs();
