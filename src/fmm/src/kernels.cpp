@@ -241,9 +241,7 @@ P2PKernel p2p_kernel_within(double max_term_error, gcsimd::SimdPath path) {
 void p2p_with(gcsimd::SimdPath path, std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns,
               const double *xs, const double *ys, const double *zs, const double *qs, double sx, double sy, double sz,
               double *pot, double *ex, double *ey, double *ez, double r2_min) {
-  if (!gcsimd::simd_path_available(path))
-    throw std::invalid_argument(std::string("gcfmm: SIMD path ") + gcsimd::simd_path_name(path) + " not available");
-  p2p_kernel(path) GCFMM_P2P_ARGS;
+  p2p_kernel_within(0.0, path).run GCFMM_P2P_ARGS;    // full precision; throws if not available
 }
 
 void p2p(std::size_t nt, const double *xt, const double *yt, const double *zt, std::size_t ns, const double *xs,
